@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages sem needs when they are missing (run as root, or with sudo).
+set -euo pipefail
+packages=(build-essential cmake pkg-config libembree-dev libsuitesparse-dev libopenblas-dev
+          liblapacke-dev libglpk-dev libcjson-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
+fi

@@ -1,0 +1,65 @@
+#define _POSIX_C_SOURCE 200809L
+#include "test_util.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+int test_failures = 0;
+int test_checks = 0;
+
+int test_finish(const char *name)
+{
+    printf("%s: %d passed, %d failed\n", name, test_checks - test_failures, test_failures);
+    return test_failures == 0 ? 0 : 1;
+}
+
+const char *test_shared_model(const char *relative)
+{
+    static char path[4096];
+    const char *root = getenv("SEM_SHARED_MODELS");
+    if (!root) root = SEM_SHARED_MODELS;
+    snprintf(path, sizeof path, "%s/%s", root, relative);
+    struct stat st;
+    if (stat(path, &st) != 0) return NULL;
+    return path;
+}
+
+const char *test_tmpdir(void)
+{
+    static char dir[256];
+    if (dir[0]) return dir;
+    snprintf(dir, sizeof dir, "/tmp/sem_test_XXXXXX");
+    if (!mkdtemp(dir)) {
+        perror("mkdtemp");
+        exit(2);
+    }
+    return dir;
+}
+
+static void slurp(const char *path, char *buf, size_t size)
+{
+    if (!buf || size == 0) return;
+    buf[0] = '\0';
+    FILE *f = fopen(path, "rb");
+    if (!f) return;
+    size_t n = fread(buf, 1, size - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+}
+
+int test_run_cli(const char *args, char *out, size_t out_size, char *errbuf, size_t err_size)
+{
+    const char *dir = test_tmpdir();
+    char cmd[8192], out_path[512], err_path[512];
+    snprintf(out_path, sizeof out_path, "%s/cli_stdout.txt", dir);
+    snprintf(err_path, sizeof err_path, "%s/cli_stderr.txt", dir);
+    snprintf(cmd, sizeof cmd, "%s %s >%s 2>%s </dev/null", SEM_BINARY, args, out_path, err_path);
+    int rc = system(cmd);
+    slurp(out_path, out, out_size);
+    slurp(err_path, errbuf, err_size);
+    if (rc == -1) return -1;
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+}

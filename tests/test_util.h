@@ -1,0 +1,49 @@
+/* test_util.h - a small test harness: each CHECK counts, failures print file:line. */
+#ifndef SEM_TEST_UTIL_H
+#define SEM_TEST_UTIL_H
+
+#include <math.h>
+#include <stdio.h>
+
+extern int test_failures;
+extern int test_checks;
+
+#define CHECK(cond, ...)                                                                  \
+    do {                                                                                  \
+        test_checks++;                                                                    \
+        if (!(cond)) {                                                                    \
+            test_failures++;                                                              \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);       \
+            fprintf(stderr, __VA_ARGS__);                                                 \
+            fprintf(stderr, "\n");                                                        \
+        }                                                                                 \
+    } while (0)
+
+/* |a - b| <= tol */
+#define CHECK_NEAR(a, b, tol)                                                             \
+    do {                                                                                  \
+        double ca_ = (a), cb_ = (b), ct_ = (tol);                                         \
+        CHECK(fabs(ca_ - cb_) <= ct_, "%s = %.17g, %s = %.17g, diff %.3g > %.3g", #a, ca_, \
+              #b, cb_, fabs(ca_ - cb_), ct_);                                             \
+    } while (0)
+
+/* |a - b| <= tol * max(|b|, tiny) */
+#define CHECK_REL(a, b, tol)                                                              \
+    do {                                                                                  \
+        double ra_ = (a), rb_ = (b), rt_ = (tol);                                         \
+        double rs_ = fabs(rb_) > 1e-300 ? fabs(rb_) : 1e-300;                              \
+        CHECK(fabs(ra_ - rb_) <= rt_ * rs_, "%s = %.17g, %s = %.17g, rel diff %.3g > %.3g", \
+              #a, ra_, #b, rb_, fabs(ra_ - rb_) / rs_, rt_);                              \
+    } while (0)
+
+/* Prints "N passed, N failed" and returns the process exit status. */
+int test_finish(const char *name);
+/* Path of a shared model (../shared/models/...) or NULL when that folder is absent. */
+const char *test_shared_model(const char *relative);
+/* A fresh temporary directory for this test (removed by the OS / CI clean clone). */
+const char *test_tmpdir(void);
+/* Runs the sem CLI with arguments; captures stdout/stderr into the given buffers
+ * (may be NULL). Returns the exit status. */
+int test_run_cli(const char *args, char *out, size_t out_size, char *errbuf, size_t err_size);
+
+#endif
