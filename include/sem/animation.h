@@ -1,0 +1,44 @@
+/*
+ * sem/animation.h - animation output: per-frame NURBS (IGES, optionally OBJ free-form),
+ * per-frame render meshes (OBJ), and one USD (usda) file of the whole animation with
+ * time-sampled points, loadable in Blender and usdview.
+ *
+ * Each frame is written atomically (temp file, then rename), so a run that stops early
+ * leaves every earlier frame complete on disk. The USD file is written by
+ * sem_animation_finish, which a caller also calls after a failed step.
+ */
+#ifndef SEM_ANIMATION_H
+#define SEM_ANIMATION_H
+
+#include "sem/model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sem_animation_def {
+    const char *dir;         /* output folder (created if missing) */
+    int write_iges, write_obj, write_mesh, write_usd;
+    int mesh_resolution;     /* tessellation cells per knot span */
+    double frames_per_second;
+} sem_animation_def;
+
+typedef struct sem_animation sem_animation;
+
+/* One object per model; the models' topology is fixed, only control points move. */
+sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
+                                const sem_model *const *models, sem_animation **out,
+                                sem_error *err);
+/* Writes frame `frame` with the objects' current control points q (3 per control point). */
+sem_status sem_animation_add_frame(sem_animation *anim, int frame, const double *const *q,
+                                   sem_error *err);
+/* Writes the USD file with every frame added so far. */
+sem_status sem_animation_finish(sem_animation *anim, sem_error *err);
+void sem_animation_destroy(sem_animation *anim);
+/* Path of the USD file (valid after create). */
+const char *sem_animation_usd_path(const sem_animation *anim);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

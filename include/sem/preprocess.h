@@ -1,0 +1,128 @@
+/*
+ * sem/preprocess.h - from a NURBS model to the SEM discrete operators (paper Sec. 5-7, Alg. 1).
+ *
+ * Pipeline (each step is a pure function in src/preprocess/, composed by sem_preprocess):
+ *   sampling    boundary Gauss-Lobatto samples, J-hat, area weights S        (Sec. 5)
+ *   quadrature  ray-cast volume points with CSG union along each ray         (Sec. 6.3, Eq. 11)
+ *   weights     blending weights by secondary rays, normalised               (Sec. 6.1, Eq. 8-9)
+ *   origins     deformation origins by min-cost network flow (GLPK)          (Sec. 6.2, Eq. 10)
+ *   projection  hierarchical polynomial fit Pi                               (Sec. 6, Eq. 7)
+ *   operators   Gamma, gradient rows, M, M_eps, gravity                      (Sec. 7, Eq. 12-16)
+ *
+ * All operators are *scalar* matrices over control points (see sem/sparse.h): the same fit
+ * applies to x, y and z. q-space (3 x control points) matrices are their Kronecker product
+ * with I3.
+ *
+ * Polynomial basis b(dX) about an origin Xbar, dX = X - Xbar (order 1: 4 terms; order 2: 10):
+ *   [1, dX, dY, dZ, dX dY, dX dZ, dY dZ, dX^2, dY^2, dZ^2]
+ * Part i's fitted map is x_d(X) = b(X - Xbar_i)^T (Pi_i Q)[:, d] where Q is the
+ * control_points x 3 matrix of q and Pi_i the rows [i*m, (i+1)*m) of Pi.
+ */
+#ifndef SEM_PREPROCESS_H
+#define SEM_PREPROCESS_H
+
+#include "sem/model.h"
+#include "sem/sparse.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sem_preprocess_options {
+    int order;               /* 1 (linear) or 2 (quadratic, default) */
+    int rays[2];             /* ray grid (n1, n2) across the ray axis; default 10 x 10 */
+    int ray_axis;            /* 0 = x (default), 1 = y, 2 = z */
+    int points_per_interval; /* volume points per inside interval; default 5 */
+    double alpha;            /* weight cut-off distance, model units; <= 0: use sparsity */
+    double sparsity;         /* target non-zero fraction T in (0,1) when alpha <= 0;
+                                when both are unset (alpha 0, sparsity 0): alpha = 0.5 x
+                                the bounding-box diagonal */
+    double weight_threshold; /* weights below are dropped; default 1e-4 */
+    double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
+    double youngs_modulus;   /* for the default gamma; default 1e6 */
+    int tessellation;        /* triangle grid cells per knot span per direction; default 8 */
+    int threads;             /* 0: OpenMP default */
+} sem_preprocess_options;
+
+sem_preprocess_options sem_default_preprocess_options(void);
+
+typedef struct sem_preprocess_timings {
+    double sample_s, quad_s, weights_s, build_pi_s, operators_s;
+} sem_preprocess_timings;
+
+typedef struct sem_discretization {
+    int order;        /* polynomial order, 1 or 2 */
+    int n_basis;      /* m = 4 or 10 */
+    int n_parts;
+    int n_ctrl;       /* control points; dofs = 3 n_ctrl */
+    int *part_ctrl_offset; /* n_parts + 1 */
+
+    /* boundary samples (Sec. 5) */
+    int n_samples;
+    int *sample_part;      /* part of each sample */
+    double *sample_uv;     /* 2 per sample */
+    double *sample_X;      /* rest position, 3 per sample */
+    double *sample_area;   /* area weight (diagonal of S) */
+    sem_csr J_hat;         /* n_samples x n_ctrl: x(sample) = J_hat Q */
+
+    /* volume quadrature (Sec. 6.3) */
+    int n_quad;
+    double *quad_X;        /* 3 per point */
+    double *quad_volume;   /* per point */
+    int *quad_part;        /* part whose material the point takes (innermost), per point */
+    double volume;         /* sum of quad_volume */
+
+    /* blending weights (Sec. 6.1) */
+    double alpha;
+    sem_csr W;             /* n_quad x n_parts, rows sum to 1 */
+    sem_csr W_samples;     /* n_samples x n_parts: weights at the boundary samples */
+
+    /* deformation origins (Sec. 6.2) */
+    int n_origins;
+    double *origin_X;      /* 3 per origin (rest) */
+    int *part_origin;      /* origin of each part */
+
+    /* projection (Eq. 7): n_parts * n_basis rows x n_ctrl */
+    sem_csr Pi;
+
+    /* operators (Sec. 7) */
+    sem_csr Gamma;         /* n_quad x n_ctrl: x(X_p) = Gamma Q (Eq. 12) */
+    sem_csr Grad;          /* 3 n_quad x n_ctrl: F_p[d][e] = (Grad[3p+e] . Q[:,d]) (Eq. 15) */
+    sem_csr Gamma_samples; /* n_samples x n_ctrl: SEM map at the boundary samples */
+    sem_csr M;             /* n_ctrl x n_ctrl, unit density: sum vol Gamma^T Gamma (Eq. 14) */
+    sem_csr M_eps;         /* n_ctrl x n_ctrl: sum area (Gamma_s - J_s)^T (Gamma_s - J_s) (Eq. 16),
+                              without gamma */
+    double gamma;          /* error stiffness to multiply M_eps with */
+    double length_scale;   /* L used for the default gamma (bbox diagonal) */
+
+    double stiffness_nnz_percent; /* non-zeros of the q-space stiffness pattern, % */
+    double weight_nonzero_fraction;
+    sem_preprocess_timings timings;
+    unsigned long long model_hash; /* of the model's geometry and the options */
+} sem_discretization;
+
+sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *options,
+                          sem_discretization **out, sem_error *err);
+void sem_discretization_destroy(sem_discretization *d);
+
+/* Versioned binary file; loading checks the version and the model/options hash. */
+sem_status sem_discretization_save(const sem_discretization *d, const char *path, sem_error *err);
+sem_status sem_discretization_load(const char *path, unsigned long long expected_hash,
+                                   sem_discretization **out, sem_error *err);
+/* Hash of a model's geometry (degrees, knots, weights, control points, trims) and options. */
+unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o);
+
+/* Polynomial basis and its gradient at dX (Eq. 3): b has n_basis entries, db 3 x n_basis
+ * (db[e * n_basis + k] = d b_k / d X_e). */
+void sem_polynomial_basis(int order, const double dX[3], double *b, double *db);
+
+/* Part `part`'s polynomial coefficients C = Pi_part Q (Eq. 7): Q is n_ctrl x width
+ * row-major (width 3 for control points), C is n_basis x width; then part i's map is
+ * x_d(X) = sum_k b_k(X - Xbar_i) C[k][d], i.e. C[k][d] = d x_d / d X_k for k = 1..3. */
+void sem_projection_coefficients(const sem_discretization *d, int part, const double *Q,
+                                 int width, double *C);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

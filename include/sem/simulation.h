@@ -1,0 +1,137 @@
+/*
+ * sem/simulation.h - elastodynamics of preprocessed SEM objects (paper Sec. 7, Alg. 2).
+ *
+ * A world holds objects; each object is a NURBS model with its discretization
+ * (sem/preprocess.h), materials, pinned control points and loads. The state of an object
+ * is its control points q (3 per control point) and their velocities. A step advances
+ * every object by dt with the chosen integrator; objects do not interact (no contact).
+ *
+ * Usage: def = sem_default_world_def(); edit; world = sem_world_create(&def, &err);
+ * obj = sem_default_object_def(); edit; sem_world_add_object(world, &obj, &err);
+ * loop sem_world_step(world, &err); read sem_world_object_q(world, i), destroy.
+ */
+#ifndef SEM_SIMULATION_H
+#define SEM_SIMULATION_H
+
+#include "sem/material.h"
+#include "sem/model.h"
+#include "sem/preprocess.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sem_integrator {
+    SEM_LINEARLY_IMPLICIT_EULER, /* the paper's: one linear solve per step */
+    SEM_IMPLICIT_EULER,          /* Newton on the incremental potential with line search */
+    SEM_STATIC                   /* Newton to equilibrium (each "step" solves statics) */
+} sem_integrator;
+
+typedef enum sem_solver_choice {
+    SEM_SOLVER_AUTO,   /* measure both once and keep the faster */
+    SEM_SOLVER_SPARSE, /* CHOLMOD */
+    SEM_SOLVER_DENSE   /* LAPACK dpotrf */
+} sem_solver_choice;
+
+typedef struct sem_world_def {
+    double gravity[3];
+    sem_integrator integrator;
+    double dt;
+    double rayleigh_mass, rayleigh_stiffness; /* damping C = a M + b K */
+    double newton_tolerance;   /* relative gradient norm; default 1e-8 */
+    int newton_max_iterations; /* default 50 (static: 200) */
+    sem_solver_choice solver;
+    int threads;               /* 0: OpenMP default */
+} sem_world_def;
+
+sem_world_def sem_default_world_def(void);
+
+typedef enum sem_prescribe_type {
+    SEM_PRESCRIBE_NONE,
+    SEM_PRESCRIBE_AFFINE, /* pinned points go to A x0 + b (reached at once) */
+    SEM_PRESCRIBE_ROTATE  /* pinned points rotate about an axis at a rate (rad/s) */
+} sem_prescribe_type;
+
+typedef struct sem_prescribe {
+    sem_prescribe_type type;
+    double affine[12];      /* 3 x 4 row-major [A | b] */
+    double axis_point[3];
+    double axis_direction[3];
+    double rate;            /* rad/s */
+    double duration;        /* rotate only until this time (<= 0: forever) */
+} sem_prescribe;
+
+/* A load on the control points near a region: force per unit volume (N/m^3) applied to the
+ * quadrature points inside the box, scaled by amplitude * (1 + sin(2 pi frequency t + phase))
+ * / 2 when frequency > 0, or constant. */
+typedef struct sem_region_load {
+    double box[6];          /* lo[3], hi[3] */
+    double force_density[3];
+    double frequency, phase;
+} sem_region_load;
+
+typedef struct sem_point_load {
+    double X[3];            /* rest position where the force acts */
+    double force[3];
+} sem_point_load;
+
+typedef struct sem_object_def {
+    const sem_model *model;              /* rest geometry (already transformed) */
+    const sem_discretization *disc;      /* preprocessed data of that model */
+    sem_material material;               /* default for every part */
+    const int *part_material;            /* per part index into part_materials, or -1; may be NULL */
+    const sem_material *part_materials;
+    int n_part_materials;
+    double gamma;                        /* error stiffness; <= 0: disc->gamma scaled by E */
+    const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
+    sem_prescribe prescribe;
+    double initial_velocity[3];
+    double initial_angular_velocity[3];  /* about the centre of mass */
+    const sem_point_load *point_loads;
+    int n_point_loads;
+    const sem_region_load *region_loads;
+    int n_region_loads;
+} sem_object_def;
+
+sem_object_def sem_default_object_def(void);
+
+typedef struct sem_world sem_world;
+
+sem_world *sem_world_create(const sem_world_def *def, sem_error *err);
+void sem_world_destroy(sem_world *world);
+/* Returns the object index or -1 (err set). */
+int sem_world_add_object(sem_world *world, const sem_object_def *def, sem_error *err);
+sem_status sem_world_step(sem_world *world, sem_error *err);
+/* Solves statics for every object (Newton on V - f^T q), whatever the integrator. */
+sem_status sem_world_solve_static(sem_world *world, sem_error *err);
+
+double sem_world_time(const sem_world *world);
+int sem_world_object_count(const sem_world *world);
+int sem_world_object_dofs(const sem_world *world, int object);
+const double *sem_world_object_q(const sem_world *world, int object);
+const double *sem_world_object_velocity(const sem_world *world, int object);
+/* Sets q and velocity (3 * control points each; NULL leaves that unchanged). */
+void sem_world_object_set_state(sem_world *world, int object, const double *q, const double *v);
+
+typedef struct sem_object_stats {
+    double volume, mass;
+    double kinetic_energy, elastic_energy, gravity_energy, error_energy;
+    double center_of_mass[3], linear_momentum[3], angular_momentum[3];
+} sem_object_stats;
+
+/* Quantities computed from the quadrature (momenta through Gamma: x and v at each
+ * quadrature point). gravity_energy = -sum rho vol g . x. */
+void sem_world_object_stats(const sem_world *world, int object, sem_object_stats *stats);
+/* Timing of the last step and the solver in use ("cholmod" or "dense"). */
+double sem_world_last_step_seconds(const sem_world *world);
+double sem_world_last_factor_seconds(const sem_world *world);
+const char *sem_world_solver_name(const sem_world *world, int object);
+/* Percentage of non-zeros of the q-space system matrix (Table 1's Nnz). */
+double sem_world_object_nnz_percent(const sem_world *world, int object);
+/* Newton iterations of the last step (implicit/static). */
+int sem_world_last_iterations(const sem_world *world);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,229 @@
+/*
+ * main.c - `sem <command> [options]`: the table of commands and the shared CLI helpers.
+ *
+ * Each command lives in its own cmd_NAME.c; this file only dispatches, prints help and
+ * holds the message/parsing helpers declared in cli.h, so that every command reports
+ * errors the same way (one "sem: ..." line, exit 1; usage errors exit 2).
+ */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+#ifndef SEM_VERSION_STRING
+#define SEM_VERSION_STRING "unknown"
+#endif
+
+typedef struct cli_command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *usage;   /* arguments after "sem NAME" */
+    const char *summary; /* one line for `sem --help` */
+    const char *help;    /* options, for `sem NAME --help` */
+} cli_command;
+
+static const cli_command commands[] = {
+    {"primitive", cmd_primitive, "box|beam|sphere|cylinder|torus [options] -o FILE",
+     "build an exact NURBS solid and save it (format by extension)",
+     "Shapes and options (lengths in model units, metres by default):\n"
+     "  box       --size X Y Z (1 1 1)  --center X Y Z (0 0 0)  --degree D (3)\n"
+     "            6 Bezier patches, bicubic by default\n"
+     "  beam      --sections N (1)  --length L (5)  --width W (1)  --height H (1)\n"
+     "            --degree D (2)   box beam along x from 0 to L, 6 + 4(N-1) patches,\n"
+     "            biquadratic like the paper's beams/perf files; x = 0 is the clamped end\n"
+     "  sphere    --radius R (1)  --center X Y Z\n"
+     "  cylinder  --radius R (1)  --height H (2)  --center X Y Z   (axis z, closed)\n"
+     "  torus     --major R (1)  --minor r (0.25)  --center X Y Z   (axis z)\n"
+     "  -o, --output FILE   where to write (.igs/.iges, .obj)\n"},
+    {"inspect", cmd_inspect, "FILE [--json]",
+     "sizes, degrees of freedom, area, bounding box and warnings of a model",
+     "  --json   print one JSON object (file, parts, control_points, dofs, trimmed_parts,\n"
+     "           bbox, area, units, warnings, part_details) instead of text\n"},
+    {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
+     "  IN and OUT: .igs/.iges or .obj\n"},
+    {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (10 10) across --axis (x)  --points-per-interval N (5)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the bbox diagonal\n  --gamma G (default E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (8)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file for sem simulate)\n"},
+    {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--quiet]",
+     "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
+     "  SCENE       a scene file (JSON, see docs/scenes.md); without it the embedded default\n"
+     "              scene runs: a rubber beam clamped at x = 0 swinging under gravity\n"
+     "  --frames N  override the scene's frame count   --out DIR  override the output folder\n"
+     "  --json      print summary.json on stdout       --no-cache recompute the preprocessing\n"
+     "  --quiet     no progress output\n"
+     "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
+     "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
+};
+
+static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
+
+static const cli_command *find_command(const char *name)
+{
+    for (int i = 0; i < n_commands; ++i)
+        if (strcmp(commands[i].name, name) == 0) return &commands[i];
+    return NULL;
+}
+
+/* ---- messages ---- */
+
+int cli_fail(const char *fmt, ...)
+{
+    char buf[2048];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    /* one line, whatever the message contains */
+    for (char *c = buf; *c; ++c)
+        if (*c == '\n' || *c == '\r') *c = ' ';
+    fprintf(stderr, "sem: %s\n", buf);
+    return CLI_FAILED;
+}
+
+int cli_fail_error(const char *path, const sem_error *err)
+{
+    const char *msg = err && err->message[0] ? err->message : "unknown error";
+    if (path && !strstr(msg, path)) return cli_fail("%s: %s", path, msg);
+    return cli_fail("%s", msg);
+}
+
+int cli_usage(const char *command, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "sem: %s\n", buf);
+    const cli_command *c = command ? find_command(command) : NULL;
+    if (c)
+        fprintf(stderr, "usage: sem %s %s  (sem %s --help for more)\n", c->name, c->usage,
+                c->name);
+    else
+        fprintf(stderr, "usage: sem <command> [options]  (sem --help for the commands)\n");
+    return CLI_USAGE;
+}
+
+void cli_warn(const char *fmt, ...)
+{
+    char buf[2048];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    for (char *c = buf; *c; ++c)
+        if (*c == '\n' || *c == '\r') *c = ' ';
+    fprintf(stderr, "sem: warning: %s\n", buf);
+}
+
+void cli_print_model_warnings(const sem_model *model)
+{
+    for (int i = 0; i < model->n_warnings; ++i)
+        if (model->warnings[i]) cli_warn("%s", model->warnings[i]);
+}
+
+int cli_print_json(cJSON *json)
+{
+    if (!json) return cli_fail("out of memory building JSON output");
+    char *text = cJSON_Print(json);
+    cJSON_Delete(json);
+    if (!text) return cli_fail("out of memory printing JSON output");
+    fputs(text, stdout);
+    fputc('\n', stdout);
+    free(text);
+    return CLI_OK;
+}
+
+/* ---- parsing ---- */
+
+int cli_parse_double(const char *command, const char *option, const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(x))
+        return cli_usage(command, "%s: '%s' is not a number", option, text);
+    *out = x;
+    return CLI_OK;
+}
+
+int cli_parse_int(const char *command, const char *option, const char *text, int *out)
+{
+    char *end;
+    errno = 0;
+    long x = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+        return cli_usage(command, "%s: '%s' is not an integer", option, text);
+    *out = (int)x;
+    return CLI_OK;
+}
+
+int cli_need_values(const char *command, int argc, char **argv, int i, int count)
+{
+    if (i + count >= argc)
+        return cli_usage(command, "%s needs %d value%s", argv[i], count, count == 1 ? "" : "s");
+    return CLI_OK;
+}
+
+int cli_is_help(const char *arg)
+{
+    return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
+}
+
+/* ---- help ---- */
+
+static void print_help(FILE *f)
+{
+    fprintf(f,
+            "sem %s - Shape Matching Element Method: animate NURBS CAD models directly\n"
+            "\n"
+            "usage: sem <command> [options]\n"
+            "       sem <command> --help\n"
+            "       sem --version\n"
+            "\n"
+            "commands:\n",
+            SEM_VERSION_STRING);
+    for (int i = 0; i < n_commands; ++i)
+        fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+}
+
+static void print_command_help(const cli_command *c)
+{
+    printf("usage: sem %s %s\n\n%s\n\n%s", c->name, c->usage, c->summary, c->help);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_help(stderr);
+        return CLI_USAGE;
+    }
+    const char *name = argv[1];
+    if (cli_is_help(name) || strcmp(name, "help") == 0) {
+        const cli_command *c = argc > 2 ? find_command(argv[2]) : NULL;
+        if (c) print_command_help(c);
+        else print_help(stdout);
+        return CLI_OK;
+    }
+    if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
+        printf("sem %s\n", SEM_VERSION_STRING);
+        return CLI_OK;
+    }
+    const cli_command *c = find_command(name);
+    if (!c) {
+        if (name[0] == '-') return cli_usage(NULL, "unknown option '%s'", name);
+        return cli_usage(NULL, "unknown command '%s'", name);
+    }
+    for (int i = 2; i < argc; ++i) {
+        if (cli_is_help(argv[i])) {
+            print_command_help(c);
+            return CLI_OK;
+        }
+    }
+    int rc = c->run(argc - 1, argv + 1);
+    if (fflush(stdout) != 0 && rc == CLI_OK) return cli_fail("cannot write to standard output");
+    return rc;
+}

@@ -1,0 +1,34 @@
+/*
+ * linear_solver.h - symmetric positive definite solves for the time steppers.
+ *
+ * The matrix pattern (upper triangle, CSC) is fixed for a simulation, so the symbolic
+ * analysis is done once (cholmod_analyze) and only the numeric factorization is repeated
+ * every step, as CHOLMOD intends. Small SEM models are nearly dense (Table 1's Nnz is
+ * 100% for many of them), where LAPACK's blocked dense Cholesky beats any sparse code:
+ * with SEM_SOLVER_AUTO the first factorization runs both and keeps the faster.
+ */
+#ifndef SEM_LINEAR_SOLVER_H
+#define SEM_LINEAR_SOLVER_H
+
+#include "sem/simulation.h"
+
+typedef struct sem_linear_solver sem_linear_solver;
+
+/* n x n, upper triangle in CSC (col_start n+1, row sorted within each column, row <= col).
+ * The arrays are copied. */
+sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
+                                    sem_solver_choice choice, sem_linear_solver **out,
+                                    sem_error *err);
+void sem_linear_solver_destroy(sem_linear_solver *s);
+/* The values of the pattern, to fill before each factorization. */
+double *sem_linear_solver_values(sem_linear_solver *s);
+sem_status sem_linear_solver_factorize(sem_linear_solver *s, sem_error *err);
+/* x = A^-1 b (x may alias b). */
+sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double *x,
+                                   sem_error *err);
+const char *sem_linear_solver_name(const sem_linear_solver *s);
+double sem_linear_solver_last_factor_seconds(const sem_linear_solver *s);
+/* Non-zeros of the full symmetric matrix as a percentage of n^2. */
+double sem_linear_solver_nnz_percent(const sem_linear_solver *s);
+
+#endif

@@ -1,0 +1,1379 @@
+/*
+ * simulation.c - SEM elastodynamics (paper Sec. 7, Alg. 2).
+ *
+ * Design. The elastic Hessian of SEM is K = sum_p vol_p B_p^T (d2psi/dF2) B_p with
+ * B_p = sum_i w_pi (grad b_i)^T Pi_i (Eq. 15). Forming B_p over control points is wasteful:
+ * a quadrature point sees only the few parts with non-zero weight there, but through Pi
+ * each part couples every control point of the parts sharing its origin. So the work is
+ * split the way the maths factors:
+ *
+ *   1. z-space (polynomial coefficients, m per part per coordinate): per point, the local
+ *      3x3 deformation gradient, psi, P, d2psi/dF2 and their pull-back to the coefficients
+ *      of the point's parts. These 3m x 3m blocks per *part pair* are tiny and cheap.
+ *   2. q-space: K_q = Pi^T K_z Pi. Pi_i's columns are exactly the control points of the
+ *      parts sharing part i's origin (its "group"), so K_q is made of dense blocks per
+ *      *group pair*; each part-pair block adds Pi_i^T K_z Pi_i' into one group-pair block
+ *      with dgemm (per coordinate pair).
+ *   3. The group-pair blocks are scattered, through a map computed once, into the fixed
+ *      CSC pattern of the free degrees of freedom for CHOLMOD (or a dense matrix).
+ *
+ * The mass matrix M (with per-point density) and the error matrix M_eps (Eq. 16) are
+ * constant and kept as scalar group-pair blocks. Error energy: gamma * sum_s a_s
+ * |Gamma_s q - J_s q|^2 = gamma q^T M_eps q, so its Hessian is 2 gamma M_eps.
+ *
+ * Pinned control points are eliminated: only free dofs enter the solve; prescribed
+ * motion of pinned points enters the right-hand side through A_fp.
+ *
+ * Every per-point Hessian is projected to positive semi-definite before assembly, for the
+ * linearly implicit step too: the paper's neo-Hookean Hessian becomes indefinite under
+ * compression, and then M + h^2 K can lose definiteness and Cholesky fails.
+ *
+ * Determinism: per-thread accumulators reduced in thread order; the thread count is fixed
+ * by the world definition (or OMP_NUM_THREADS).
+ */
+#include "sem/simulation.h"
+
+#include <cblas.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linear_solver.h"
+
+typedef struct object {
+    sem_object_def def;
+    const sem_discretization *d;
+    int n_ctrl, n_parts, m, n_quad;
+    double *q, *v, *q0;        /* 3 n_ctrl */
+    /* per quadrature point */
+    const sem_material **point_material;
+    double *point_rho_vol;
+    double *entry_grad;        /* per W entry: m x 3, w * d b_k / dX_e */
+    double *entry_basis;       /* per W entry: m, w * b_k */
+    int *entry_pair_offset;    /* per point: start into point_pairs (k*k pairs) */
+    int *point_pairs;
+    /* part pairs (z-space blocks) */
+    int n_pairs;
+    int *pair_a, *pair_b;
+    int *pair_lookup;          /* n_parts^2 -> pair or -1 */
+    /* groups (one per origin) */
+    int n_groups;
+    int *group_start, *group_ctrl; /* CSR: control points of each group */
+    int *ctrl_group, *ctrl_local;
+    double **pi_dense;         /* per part: m x |group| row-major */
+    /* group-pair blocks */
+    int n_gpairs;
+    int *gpair_a, *gpair_b;
+    int *gpair_lookup;         /* n_groups^2 -> gpair or -1 */
+    size_t *gpair_offset;      /* scalar block offsets (size |Ga||Gb|), n_gpairs + 1 */
+    int *part_pair_gpair;      /* per part pair */
+    int *gpair_pairs_start, *gpair_pairs; /* part pairs per group pair */
+    double *K_blocks;          /* 9 * gpair_offset[n] : sub-block (d,d') at 9*off + (3d+d')*size */
+    double *M_blocks;          /* gpair_offset[n] */
+    double *E_blocks;          /* error matrix, gpair_offset[n] */
+    double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
+    /* forces */
+    double *f_gravity;         /* 3 n_ctrl */
+    double gamma;
+    /* free dofs */
+    unsigned char *pinned;
+    int *free_index;           /* per ctrl: free index or -1 */
+    int n_free;
+    int *map;                  /* per block entry (9 per scalar entry): CSC position or -1 */
+    sem_linear_solver *solver;
+    /* z-space work */
+    double *z;                 /* n_parts*m x 3 */
+    double *grad_z;            /* n_parts*m x 3 */
+    double *Kz;                /* n_pairs x (3m)^2 */
+    int nthreads;
+    double *Kz_thread, *grad_z_thread;
+    double elastic_energy;
+    double volume, mass;
+} object;
+
+struct sem_world {
+    sem_world_def def;
+    int n_objects, cap;
+    object **objects;
+    double time;
+    int step_index;
+    double last_step_s, last_factor_s;
+    int last_iterations;
+};
+
+sem_world_def sem_default_world_def(void)
+{
+    sem_world_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity[2] = -9.81;
+    d.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    d.dt = 0.01;
+    d.newton_tolerance = 1e-8;
+    d.newton_max_iterations = 50;
+    d.solver = SEM_SOLVER_AUTO;
+    return d;
+}
+
+sem_object_def sem_default_object_def(void)
+{
+    sem_object_def d;
+    memset(&d, 0, sizeof d);
+    d.material = sem_default_material();
+    return d;
+}
+
+sem_world *sem_world_create(const sem_world_def *def, sem_error *err)
+{
+    if (!(def->dt > 0) || !isfinite(def->dt)) {
+        sem_error_set(err, SEM_ERR_INVALID, "time step dt must be positive (got %g)", def->dt);
+        return NULL;
+    }
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(def->gravity[k])) {
+            sem_error_set(err, SEM_ERR_INVALID, "gravity must be finite");
+            return NULL;
+        }
+    if (def->rayleigh_mass < 0 || def->rayleigh_stiffness < 0) {
+        sem_error_set(err, SEM_ERR_INVALID, "Rayleigh damping coefficients must be >= 0");
+        return NULL;
+    }
+    sem_world *w = calloc(1, sizeof *w);
+    if (!w) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    w->def = *def;
+    if (w->def.newton_tolerance <= 0) w->def.newton_tolerance = 1e-8;
+    if (w->def.newton_max_iterations <= 0) w->def.newton_max_iterations = 50;
+    return w;
+}
+
+static void object_destroy(object *o)
+{
+    if (!o) return;
+    free(o->q);
+    free(o->v);
+    free(o->q0);
+    free(o->point_material);
+    free(o->point_rho_vol);
+    free(o->entry_grad);
+    free(o->entry_basis);
+    free(o->entry_pair_offset);
+    free(o->point_pairs);
+    free(o->pair_a);
+    free(o->pair_b);
+    free(o->pair_lookup);
+    free(o->group_start);
+    free(o->group_ctrl);
+    free(o->ctrl_group);
+    free(o->ctrl_local);
+    if (o->pi_dense)
+        for (int i = 0; i < o->n_parts; ++i) free(o->pi_dense[i]);
+    free(o->pi_dense);
+    free(o->gpair_a);
+    free(o->gpair_b);
+    free(o->gpair_lookup);
+    free(o->gpair_offset);
+    free(o->part_pair_gpair);
+    free(o->gpair_pairs_start);
+    free(o->gpair_pairs);
+    free(o->K_blocks);
+    free(o->M_blocks);
+    free(o->E_blocks);
+    free(o->K0_blocks);
+    free(o->f_gravity);
+    free(o->pinned);
+    free(o->free_index);
+    free(o->map);
+    sem_linear_solver_destroy(o->solver);
+    free(o->z);
+    free(o->grad_z);
+    free(o->Kz);
+    free(o->Kz_thread);
+    free(o->grad_z_thread);
+    free((void *)o->def.point_loads);
+    free((void *)o->def.region_loads);
+    free(o);
+}
+
+void sem_world_destroy(sem_world *w)
+{
+    if (!w) return;
+    for (int i = 0; i < w->n_objects; ++i) object_destroy(w->objects[i]);
+    free(w->objects);
+    free(w);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* setup                                                                               */
+
+static size_t gsize(const object *o, int g)
+{
+    return (size_t)(o->group_start[g + 1] - o->group_start[g]);
+}
+
+static sem_status setup_groups(object *o, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    int ng = d->n_origins;
+    o->n_groups = ng;
+    o->group_start = calloc((size_t)ng + 1, sizeof(int));
+    o->group_ctrl = malloc((size_t)o->n_ctrl * sizeof(int));
+    o->ctrl_group = malloc((size_t)o->n_ctrl * sizeof(int));
+    o->ctrl_local = malloc((size_t)o->n_ctrl * sizeof(int));
+    if (!o->group_start || !o->group_ctrl || !o->ctrl_group || !o->ctrl_local)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = d->part_origin[i];
+        if (g < 0 || g >= ng)
+            return sem_error_set(err, SEM_ERR_INVALID, "part %d has no valid origin", i);
+        o->group_start[g + 1] += d->part_ctrl_offset[i + 1] - d->part_ctrl_offset[i];
+    }
+    for (int g = 0; g < ng; ++g) o->group_start[g + 1] += o->group_start[g];
+    int *fill = malloc((size_t)ng * sizeof(int));
+    if (!fill) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    memcpy(fill, o->group_start, (size_t)ng * sizeof(int));
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = d->part_origin[i];
+        for (int c = d->part_ctrl_offset[i]; c < d->part_ctrl_offset[i + 1]; ++c) {
+            o->ctrl_group[c] = g;
+            o->ctrl_local[c] = fill[g] - o->group_start[g];
+            o->group_ctrl[fill[g]++] = c;
+        }
+    }
+    free(fill);
+    /* dense Pi per part over its group's control points */
+    o->pi_dense = calloc((size_t)(o->n_parts > 0 ? o->n_parts : 1), sizeof(double *));
+    if (!o->pi_dense) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    int m = o->m;
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = d->part_origin[i];
+        size_t n = gsize(o, g);
+        o->pi_dense[i] = calloc((size_t)m * n, sizeof(double));
+        if (!o->pi_dense[i]) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int k = 0; k < m; ++k) {
+            int row = i * m + k;
+            for (int e = d->Pi.row_start[row]; e < d->Pi.row_start[row + 1]; ++e) {
+                int c = d->Pi.col[e];
+                if (o->ctrl_group[c] != g)
+                    return sem_error_set(err, SEM_ERR_INVALID,
+                                         "projection of part %d reaches a control point outside "
+                                         "its origin's parts",
+                                         i);
+                o->pi_dense[i][(size_t)k * n + (size_t)o->ctrl_local[c]] = d->Pi.val[e];
+            }
+        }
+    }
+    return SEM_OK;
+}
+
+/* Part pairs from the weights at quadrature points and boundary samples; group pairs
+ * from part pairs and from the error matrix. */
+static sem_status setup_pairs(object *o, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    int np = o->n_parts, ng = o->n_groups;
+    o->pair_lookup = malloc((size_t)np * np * sizeof(int));
+    o->gpair_lookup = malloc((size_t)ng * ng * sizeof(int));
+    if (!o->pair_lookup || !o->gpair_lookup) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (size_t k = 0; k < (size_t)np * np; ++k) o->pair_lookup[k] = -1;
+    for (size_t k = 0; k < (size_t)ng * ng; ++k) o->gpair_lookup[k] = -1;
+    int cap = 64;
+    o->pair_a = malloc((size_t)cap * sizeof(int));
+    o->pair_b = malloc((size_t)cap * sizeof(int));
+    if (!o->pair_a || !o->pair_b) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    const sem_csr *Ws[2] = {&d->W, &d->W_samples};
+    for (int w = 0; w < 2; ++w) {
+        const sem_csr *W = Ws[w];
+        for (int p = 0; p < W->n_rows; ++p)
+            for (int a = W->row_start[p]; a < W->row_start[p + 1]; ++a)
+                for (int b = W->row_start[p]; b < W->row_start[p + 1]; ++b) {
+                    int i = W->col[a], j = W->col[b];
+                    if (o->pair_lookup[(size_t)i * np + j] >= 0) continue;
+                    if (o->n_pairs == cap) {
+                        cap *= 2;
+                        int *x = realloc(o->pair_a, (size_t)cap * sizeof(int));
+                        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                        o->pair_a = x;
+                        x = realloc(o->pair_b, (size_t)cap * sizeof(int));
+                        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                        o->pair_b = x;
+                    }
+                    o->pair_lookup[(size_t)i * np + j] = o->n_pairs;
+                    o->pair_a[o->n_pairs] = i;
+                    o->pair_b[o->n_pairs] = j;
+                    o->n_pairs++;
+                }
+    }
+    /* group pairs: from part pairs, and from the error matrix's pattern */
+    o->part_pair_gpair = malloc((size_t)o->n_pairs * sizeof(int));
+    int gcap = 64;
+    o->gpair_a = malloc((size_t)gcap * sizeof(int));
+    o->gpair_b = malloc((size_t)gcap * sizeof(int));
+    if (!o->part_pair_gpair || !o->gpair_a || !o->gpair_b)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+#define ADD_GPAIR(ga, gb)                                                                   \
+    do {                                                                                    \
+        size_t key_ = (size_t)(ga) * ng + (size_t)(gb);                                     \
+        if (o->gpair_lookup[key_] < 0) {                                                    \
+            if (o->n_gpairs == gcap) {                                                      \
+                gcap *= 2;                                                                  \
+                int *x_ = realloc(o->gpair_a, (size_t)gcap * sizeof(int));                  \
+                if (!x_) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");         \
+                o->gpair_a = x_;                                                            \
+                x_ = realloc(o->gpair_b, (size_t)gcap * sizeof(int));                       \
+                if (!x_) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");         \
+                o->gpair_b = x_;                                                            \
+            }                                                                               \
+            o->gpair_lookup[key_] = o->n_gpairs;                                            \
+            o->gpair_a[o->n_gpairs] = (ga);                                                 \
+            o->gpair_b[o->n_gpairs] = (gb);                                                 \
+            o->n_gpairs++;                                                                  \
+        }                                                                                   \
+    } while (0)
+    for (int k = 0; k < o->n_pairs; ++k) {
+        int ga = d->part_origin[o->pair_a[k]], gb = d->part_origin[o->pair_b[k]];
+        ADD_GPAIR(ga, gb);
+        o->part_pair_gpair[k] = o->gpair_lookup[(size_t)ga * ng + gb];
+    }
+    for (int r = 0; r < d->M_eps.n_rows; ++r)
+        for (int e = d->M_eps.row_start[r]; e < d->M_eps.row_start[r + 1]; ++e) {
+            int ga = o->ctrl_group[r], gb = o->ctrl_group[d->M_eps.col[e]];
+            ADD_GPAIR(ga, gb);
+        }
+    for (int r = 0; r < d->M.n_rows; ++r)
+        for (int e = d->M.row_start[r]; e < d->M.row_start[r + 1]; ++e) {
+            int ga = o->ctrl_group[r], gb = o->ctrl_group[d->M.col[e]];
+            ADD_GPAIR(ga, gb);
+        }
+#undef ADD_GPAIR
+    o->gpair_offset = malloc(((size_t)o->n_gpairs + 1) * sizeof(size_t));
+    if (!o->gpair_offset) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    o->gpair_offset[0] = 0;
+    for (int k = 0; k < o->n_gpairs; ++k)
+        o->gpair_offset[k + 1] = o->gpair_offset[k] + gsize(o, o->gpair_a[k]) * gsize(o, o->gpair_b[k]);
+    /* part pairs per group pair (for a parallel, race-free Pi^T Kz Pi) */
+    o->gpair_pairs_start = calloc((size_t)o->n_gpairs + 1, sizeof(int));
+    o->gpair_pairs = malloc(((size_t)o->n_pairs + 1) * sizeof(int));
+    if (!o->gpair_pairs_start || !o->gpair_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int k = 0; k < o->n_pairs; ++k) o->gpair_pairs_start[o->part_pair_gpair[k] + 1]++;
+    for (int g = 0; g < o->n_gpairs; ++g) o->gpair_pairs_start[g + 1] += o->gpair_pairs_start[g];
+    int *fill = malloc(((size_t)o->n_gpairs + 1) * sizeof(int));
+    if (!fill) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    memcpy(fill, o->gpair_pairs_start, (size_t)o->n_gpairs * sizeof(int));
+    for (int k = 0; k < o->n_pairs; ++k) o->gpair_pairs[fill[o->part_pair_gpair[k]]++] = k;
+    free(fill);
+    size_t total = o->gpair_offset[o->n_gpairs];
+    o->K_blocks = calloc(9 * total + 1, sizeof(double));
+    o->K0_blocks = calloc(9 * total + 1, sizeof(double));
+    o->M_blocks = calloc(total + 1, sizeof(double));
+    o->E_blocks = calloc(total + 1, sizeof(double));
+    if (!o->K_blocks || !o->K0_blocks || !o->M_blocks || !o->E_blocks)
+        return sem_error_set(err, SEM_ERR_NOMEM,
+                             "out of memory for the system blocks (%zu entries)", 9 * total);
+    return SEM_OK;
+}
+
+/* Per-point data in z-space: w * b and w * grad b at X_p - Xbar_i for each weight entry. */
+static sem_status setup_points(object *o, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *W = &d->W;
+    size_t n_entries = sem_csr_nnz(W);
+    int m = o->m;
+    o->entry_grad = malloc((n_entries * (size_t)m * 3 + 1) * sizeof(double));
+    o->entry_basis = malloc((n_entries * (size_t)m + 1) * sizeof(double));
+    o->entry_pair_offset = malloc(((size_t)o->n_quad + 1) * sizeof(int));
+    if (!o->entry_grad || !o->entry_basis || !o->entry_pair_offset)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    size_t n_pp = 0;
+    o->entry_pair_offset[0] = 0;
+    for (int p = 0; p < o->n_quad; ++p) {
+        size_t k = (size_t)(W->row_start[p + 1] - W->row_start[p]);
+        n_pp += k * k;
+        o->entry_pair_offset[p + 1] = (int)n_pp;
+    }
+    o->point_pairs = malloc((n_pp + 1) * sizeof(int));
+    if (!o->point_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+#pragma omp parallel for schedule(static)
+    for (int p = 0; p < o->n_quad; ++p) {
+        const double *X = d->quad_X + 3 * (size_t)p;
+        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+        int pp = o->entry_pair_offset[p];
+        for (int r = r0; r < r1; ++r) {
+            int i = W->col[r];
+            const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+            double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]};
+            double b[10], db[30];
+            sem_polynomial_basis(o->d->order, dX, b, db);
+            double w = W->val[r];
+            double *g = o->entry_grad + (size_t)r * m * 3;
+            for (int k = 0; k < m; ++k) {
+                o->entry_basis[(size_t)r * m + k] = w * b[k];
+                for (int e = 0; e < 3; ++e) g[k * 3 + e] = w * db[e * m + k];
+            }
+            for (int r2 = r0; r2 < r1; ++r2)
+                o->point_pairs[pp++] = o->pair_lookup[(size_t)i * o->n_parts + W->col[r2]];
+        }
+    }
+    return SEM_OK;
+}
+
+/* Adds Pi_a^T X Pi_b for a part pair into its group-pair block. X is m x m with leading
+ * dimension ldx; block is |Ga| x |Gb| row-major; tmp has room for m x |Gb|. */
+static void add_projected(const object *o, int pa, int pb, const double *X, int ldx, double *block,
+                          double *tmp)
+{
+    int m = o->m;
+    int na = (int)gsize(o, o->d->part_origin[pa]), nb = (int)gsize(o, o->d->part_origin[pb]);
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, m, nb, m, 1.0, X, ldx, o->pi_dense[pb],
+                nb, 0.0, tmp, nb);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[pa], na, tmp,
+                nb, 1.0, block, nb);
+}
+
+static size_t max_group(const object *o)
+{
+    size_t mx = 1;
+    for (int g = 0; g < o->n_groups; ++g)
+        if (gsize(o, g) > mx) mx = gsize(o, g);
+    return mx;
+}
+
+/* Constant blocks: mass with per-point density, and the error matrix. */
+static sem_status setup_constant_blocks(object *o, sem_error *err)
+{
+    int m = o->m, np = o->n_pairs;
+    double *Mz = calloc((size_t)np * m * m + 1, sizeof(double));
+    if (!Mz) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    const sem_csr *W = &o->d->W;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double rv = o->point_rho_vol[p];
+        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+        int pp = o->entry_pair_offset[p];
+        for (int a = r0; a < r1; ++a)
+            for (int b = r0; b < r1; ++b) {
+                double *blk = Mz + (size_t)o->point_pairs[pp++] * m * m;
+                const double *ba = o->entry_basis + (size_t)a * m, *bb = o->entry_basis + (size_t)b * m;
+                for (int k = 0; k < m; ++k)
+                    for (int l = 0; l < m; ++l) blk[k * m + l] += rv * ba[k] * bb[l];
+            }
+    }
+    size_t mg = max_group(o);
+    double *tmp = malloc((size_t)m * mg * sizeof(double));
+    if (!tmp) {
+        free(Mz);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int k = 0; k < np; ++k) {
+        int g = o->part_pair_gpair[k];
+        add_projected(o, o->pair_a[k], o->pair_b[k], Mz + (size_t)k * m * m, m,
+                      o->M_blocks + o->gpair_offset[g], tmp);
+    }
+    free(tmp);
+    free(Mz);
+    /* error matrix: scatter the scalar CSR */
+    const sem_csr *E = &o->d->M_eps;
+    for (int r = 0; r < E->n_rows; ++r)
+        for (int e = E->row_start[r]; e < E->row_start[r + 1]; ++e) {
+            int c = E->col[e];
+            int ga = o->ctrl_group[r], gb = o->ctrl_group[c];
+            int g = o->gpair_lookup[(size_t)ga * o->n_groups + gb];
+            size_t nb = gsize(o, gb);
+            o->E_blocks[o->gpair_offset[g] + (size_t)o->ctrl_local[r] * nb + (size_t)o->ctrl_local[c]] +=
+                E->val[e];
+        }
+    return SEM_OK;
+}
+
+/* CSC pattern of the free system (upper triangle) and the map from block entries. */
+static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *err)
+{
+    int nf = 3 * o->n_free;
+    size_t total = o->gpair_offset[o->n_gpairs];
+    o->map = malloc((9 * total + 1) * sizeof(int));
+    int *count = calloc((size_t)nf + 1, sizeof(int));
+    if (!o->map || !count) {
+        free(count);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+    }
+    /* pass 1: count entries per column (row <= col) */
+    for (int pass = 0; pass < 2; ++pass) {
+        int *rows = NULL;
+        int *fill = NULL;
+        if (pass == 1) {
+            for (int c = 0; c < nf; ++c) count[c + 1] += count[c];
+            rows = malloc(((size_t)count[nf] + 1) * sizeof(int));
+            fill = malloc(((size_t)nf + 1) * sizeof(int));
+            if (!rows || !fill) {
+                free(rows);
+                free(fill);
+                free(count);
+                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+            }
+            memcpy(fill, count, (size_t)nf * sizeof(int));
+        }
+        for (int g = 0; g < o->n_gpairs; ++g) {
+            int ga = o->gpair_a[g], gb = o->gpair_b[g];
+            size_t na = gsize(o, ga), nb = gsize(o, gb);
+            for (size_t la = 0; la < na; ++la) {
+                int fa = o->free_index[o->group_ctrl[o->group_start[ga] + la]];
+                for (size_t lb = 0; lb < nb; ++lb) {
+                    int fb = o->free_index[o->group_ctrl[o->group_start[gb] + lb]];
+                    for (int dd = 0; dd < 9; ++dd) {
+                        int d1 = dd / 3, d2 = dd % 3;
+                        size_t idx = 9 * o->gpair_offset[g] + (size_t)dd * na * nb + la * nb + lb;
+                        if (fa < 0 || fb < 0) {
+                            if (pass == 1) o->map[idx] = -1;
+                            continue;
+                        }
+                        int r = 3 * fa + d1, c = 3 * fb + d2;
+                        if (r > c) {
+                            if (pass == 1) o->map[idx] = -1;
+                            continue;
+                        }
+                        if (pass == 0)
+                            count[c + 1]++;
+                        else {
+                            rows[fill[c]] = r;
+                            o->map[idx] = fill[c]++;
+                        }
+                    }
+                }
+            }
+        }
+        if (pass == 1) {
+            /* Each (r,c) occurs once: group pairs are distinct and a control point is in one
+             * group. Sort rows within columns and remap positions. */
+            int *perm = malloc(((size_t)count[nf] + 1) * sizeof(int));
+            int *inv = malloc(((size_t)count[nf] + 1) * sizeof(int));
+            if (!perm || !inv) {
+                free(perm);
+                free(inv);
+                free(rows);
+                free(fill);
+                free(count);
+                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            }
+            for (int c = 0; c < nf; ++c) {
+                int a = count[c], b = count[c + 1];
+                /* insertion sort is fine for short columns; use counting by row otherwise */
+                for (int k = a; k < b; ++k) perm[k] = k;
+                for (int k = a + 1; k < b; ++k) {
+                    int x = perm[k], j = k - 1;
+                    while (j >= a && rows[perm[j]] > rows[x]) {
+                        perm[j + 1] = perm[j];
+                        --j;
+                    }
+                    perm[j + 1] = x;
+                }
+                for (int k = a; k < b; ++k) inv[perm[k]] = k;
+            }
+            int *sorted = malloc(((size_t)count[nf] + 1) * sizeof(int));
+            if (!sorted) {
+                free(perm);
+                free(inv);
+                free(rows);
+                free(fill);
+                free(count);
+                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            }
+            for (int k = 0; k < count[nf]; ++k) sorted[inv[k]] = rows[k];
+            for (size_t k = 0; k < 9 * total; ++k)
+                if (o->map[k] >= 0) o->map[k] = inv[o->map[k]];
+            sem_status st = sem_linear_solver_create(nf, count, sorted, wd->solver, &o->solver, err);
+            free(sorted);
+            free(perm);
+            free(inv);
+            free(rows);
+            free(fill);
+            free(count);
+            return st;
+        }
+    }
+    free(count);
+    return SEM_OK;
+}
+
+static const sem_material *material_of_part(const sem_object_def *def, int part)
+{
+    if (def->part_material && def->part_materials) {
+        int k = def->part_material[part];
+        if (k >= 0 && k < def->n_part_materials) return &def->part_materials[k];
+    }
+    return &def->material;
+}
+
+static void compute_gravity(object *o, const double g[3])
+{
+    const sem_csr *G = &o->d->Gamma;
+    double *fp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+    if (!fp) return;
+    for (int p = 0; p < o->n_quad; ++p)
+        for (int k = 0; k < 3; ++k) fp[3 * p + k] = o->point_rho_vol[p] * g[k];
+    sem_csr_multiply_transpose(G, fp, 3, o->f_gravity);
+    free(fp);
+}
+
+static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
+                                   sem_error *err);
+
+int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
+{
+    if (!def->model || !def->disc) {
+        sem_error_set(err, SEM_ERR_INVALID, "object needs a model and its discretization");
+        return -1;
+    }
+    const sem_discretization *d = def->disc;
+    if ((size_t)d->n_ctrl != sem_model_control_points(def->model) || d->n_parts != def->model->n_parts) {
+        sem_error_set(err, SEM_ERR_INVALID, "discretization does not match the model");
+        return -1;
+    }
+    object *o = calloc(1, sizeof *o);
+    if (!o) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    o->def = *def;
+    o->def.point_loads = NULL;
+    o->def.region_loads = NULL;
+    o->def.n_point_loads = 0;
+    o->def.n_region_loads = 0;
+    if (def->n_point_loads > 0) {
+        sem_point_load *pl = malloc((size_t)def->n_point_loads * sizeof *pl);
+        if (pl) {
+            memcpy(pl, def->point_loads, (size_t)def->n_point_loads * sizeof *pl);
+            o->def.point_loads = pl;
+            o->def.n_point_loads = def->n_point_loads;
+        }
+    }
+    if (def->n_region_loads > 0) {
+        sem_region_load *rl = malloc((size_t)def->n_region_loads * sizeof *rl);
+        if (rl) {
+            memcpy(rl, def->region_loads, (size_t)def->n_region_loads * sizeof *rl);
+            o->def.region_loads = rl;
+            o->def.n_region_loads = def->n_region_loads;
+        }
+    }
+    o->d = d;
+    o->n_ctrl = d->n_ctrl;
+    o->n_parts = d->n_parts;
+    o->m = d->n_basis;
+    o->n_quad = d->n_quad;
+    size_t nq = 3 * (size_t)o->n_ctrl;
+    sem_status st = SEM_OK;
+    o->q = malloc(nq * sizeof(double));
+    o->v = calloc(nq, sizeof(double));
+    o->q0 = malloc(nq * sizeof(double));
+    o->f_gravity = calloc(nq, sizeof(double));
+    o->point_material = malloc(((size_t)o->n_quad + 1) * sizeof(*o->point_material));
+    o->point_rho_vol = malloc(((size_t)o->n_quad + 1) * sizeof(double));
+    o->pinned = calloc((size_t)o->n_ctrl, 1);
+    o->free_index = malloc((size_t)o->n_ctrl * sizeof(int));
+    o->z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
+    o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
+    if (!o->q || !o->v || !o->q0 || !o->f_gravity || !o->point_material || !o->point_rho_vol ||
+        !o->pinned || !o->free_index || !o->z || !o->grad_z) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    /* materials */
+    {
+        sem_material mat = def->material;
+        if ((st = sem_material_init(&mat, err)) != SEM_OK) goto fail;
+        o->def.material = mat;
+        for (int k = 0; k < def->n_part_materials; ++k) {
+            sem_material pm = def->part_materials[k];
+            if ((st = sem_material_init(&pm, err)) != SEM_OK) goto fail;
+        }
+    }
+    sem_model_get_q(def->model, o->q0);
+    memcpy(o->q, o->q0, nq * sizeof(double));
+    o->volume = 0;
+    o->mass = 0;
+    for (int p = 0; p < o->n_quad; ++p) {
+        int part = d->quad_part ? d->quad_part[p] : 0;
+        if (part < 0 || part >= o->n_parts) part = 0;
+        const sem_material *mt = material_of_part(&o->def, part);
+        o->point_material[p] = mt;
+        o->point_rho_vol[p] = mt->density * d->quad_volume[p];
+        o->volume += d->quad_volume[p];
+        o->mass += o->point_rho_vol[p];
+    }
+    if (def->pinned) memcpy(o->pinned, def->pinned, (size_t)o->n_ctrl);
+    if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned)
+        memset(o->pinned, 1, (size_t)o->n_ctrl); /* prescribe all control points */
+    o->n_free = 0;
+    for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
+    /* error stiffness: the discretization's default is for its E; rescale to ours */
+    o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
+    if ((st = setup_groups(o, err)) != SEM_OK) goto fail;
+    if ((st = setup_pairs(o, err)) != SEM_OK) goto fail;
+    if ((st = setup_points(o, err)) != SEM_OK) goto fail;
+    if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
+    o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
+    size_t kz = (size_t)o->n_pairs * 9 * o->m * o->m;
+    o->Kz = malloc((kz + 1) * sizeof(double));
+    o->Kz_thread = malloc(((size_t)o->nthreads * kz + 1) * sizeof(double));
+    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->m * 3 + 1) * sizeof(double));
+    if (!o->Kz || !o->Kz_thread || !o->grad_z_thread) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    compute_gravity(o, w->def.gravity);
+    if (o->n_free > 0 && (st = setup_system(o, &w->def, err)) != SEM_OK) goto fail;
+    /* rest stiffness for Rayleigh damping */
+    if ((st = assemble_elastic(o, o->q0, 1, NULL, err)) != SEM_OK) goto fail;
+    memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
+    /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
+    {
+        sem_object_stats s;
+        double com[3] = {0, 0, 0};
+        if (o->mass > 0) {
+            double *xp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+            if (!xp) {
+                sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+            sem_csr_multiply(&d->Gamma, o->q, 3, xp);
+            for (int p = 0; p < o->n_quad; ++p)
+                for (int k = 0; k < 3; ++k) com[k] += o->point_rho_vol[p] * xp[3 * p + k];
+            for (int k = 0; k < 3; ++k) com[k] /= o->mass;
+            free(xp);
+        }
+        (void)s;
+        const double *v0 = def->initial_velocity, *om = def->initial_angular_velocity;
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            if (o->pinned[c]) continue;
+            const double *x = o->q + 3 * c;
+            double r[3] = {x[0] - com[0], x[1] - com[1], x[2] - com[2]};
+            o->v[3 * c + 0] = v0[0] + om[1] * r[2] - om[2] * r[1];
+            o->v[3 * c + 1] = v0[1] + om[2] * r[0] - om[0] * r[2];
+            o->v[3 * c + 2] = v0[2] + om[0] * r[1] - om[1] * r[0];
+        }
+    }
+    if (w->n_objects == w->cap) {
+        int nc = w->cap ? 2 * w->cap : 4;
+        object **x = realloc(w->objects, (size_t)nc * sizeof *x);
+        if (!x) {
+            sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        w->objects = x;
+        w->cap = nc;
+    }
+    w->objects[w->n_objects] = o;
+    return w->n_objects++;
+fail:
+    object_destroy(o);
+    return -1;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* assembly                                                                            */
+
+/* Elastic energy, gradient in q (if grad_q) and, if want_hessian, K_blocks. */
+static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
+                                   sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *W = &d->W;
+    int m = o->m, m3 = 3 * m;
+    size_t nz = (size_t)o->n_parts * m * 3;
+    size_t kz = (size_t)o->n_pairs * m3 * m3;
+    /* z = Pi Q */
+    sem_csr_multiply(&d->Pi, q, 3, o->z);
+    int nth = o->nthreads;
+    double energy_total = 0;
+    int bad = 0;
+    double *thread_energy = calloc((size_t)nth, sizeof(double));
+    if (!thread_energy) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+#pragma omp parallel num_threads(nth) reduction(| : bad)
+    {
+        int t = omp_get_thread_num();
+        int nt = omp_get_num_threads();
+        double *gz = o->grad_z_thread + (size_t)t * nz;
+        double *Kt = o->Kz_thread + (size_t)t * kz;
+        memset(gz, 0, nz * sizeof(double));
+        if (want_hessian) memset(Kt, 0, kz * sizeof(double));
+        double energy = 0;
+        /* static contiguous chunks: deterministic for a fixed thread count */
+        int chunk = (o->n_quad + nt - 1) / nt;
+        int p0 = t * chunk, p1 = p0 + chunk < o->n_quad ? p0 + chunk : o->n_quad;
+        double HG[9 * 30];
+        for (int p = p0; p < p1; ++p) {
+            int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+            double F[9] = {0};
+            for (int r = r0; r < r1; ++r) {
+                const double *g = o->entry_grad + (size_t)r * m * 3;
+                const double *zi = o->z + (size_t)W->col[r] * m * 3;
+                for (int k = 0; k < m; ++k)
+                    for (int dd = 0; dd < 3; ++dd) {
+                        double zk = zi[k * 3 + dd];
+                        F[dd * 3 + 0] += g[k * 3 + 0] * zk;
+                        F[dd * 3 + 1] += g[k * 3 + 1] * zk;
+                        F[dd * 3 + 2] += g[k * 3 + 2] * zk;
+                    }
+            }
+            double P[9], H[81];
+            double vol = d->quad_volume[p];
+            double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
+            if (!isfinite(psi)) {
+                bad = 1;
+                continue;
+            }
+            energy += vol * psi;
+            if (want_hessian) sem_project_psd_9x9(H);
+            for (int r = r0; r < r1; ++r) {
+                const double *g = o->entry_grad + (size_t)r * m * 3;
+                double *gzi = gz + (size_t)W->col[r] * m * 3;
+                for (int k = 0; k < m; ++k)
+                    for (int dd = 0; dd < 3; ++dd)
+                        gzi[k * 3 + dd] += vol * (P[dd * 3 + 0] * g[k * 3 + 0] + P[dd * 3 + 1] * g[k * 3 + 1] +
+                                                  P[dd * 3 + 2] * g[k * 3 + 2]);
+            }
+            if (!want_hessian) continue;
+            int pp = o->entry_pair_offset[p];
+            for (int ra = r0; ra < r1; ++ra) {
+                const double *ga = o->entry_grad + (size_t)ra * m * 3;
+                for (int rb = r0; rb < r1; ++rb) {
+                    const double *gb = o->entry_grad + (size_t)rb * m * 3;
+                    /* HG[(d,e)][(k',d')] = sum_e' H[(d,e),(d',e')] gb[k'][e'] */
+                    for (int de = 0; de < 9; ++de)
+                        for (int k2 = 0; k2 < m; ++k2)
+                            for (int d2 = 0; d2 < 3; ++d2) {
+                                const double *h = H + de * 9 + d2 * 3;
+                                HG[de * m3 + d2 * m + k2] =
+                                    h[0] * gb[k2 * 3 + 0] + h[1] * gb[k2 * 3 + 1] + h[2] * gb[k2 * 3 + 2];
+                            }
+                    /* Kz[(d,k)][(d',k')] += vol sum_e ga[k][e] HG[(d,e)][(d',k')] */
+                    double *K = Kt + (size_t)o->point_pairs[pp++] * m3 * m3;
+                    for (int d1 = 0; d1 < 3; ++d1)
+                        for (int k1 = 0; k1 < m; ++k1) {
+                            double a0 = vol * ga[k1 * 3 + 0], a1 = vol * ga[k1 * 3 + 1],
+                                   a2 = vol * ga[k1 * 3 + 2];
+                            if (a0 == 0 && a1 == 0 && a2 == 0) continue;
+                            const double *h0 = HG + (d1 * 3 + 0) * m3, *h1 = HG + (d1 * 3 + 1) * m3,
+                                         *h2 = HG + (d1 * 3 + 2) * m3;
+                            double *Krow = K + (size_t)(d1 * m + k1) * m3;
+                            for (int c = 0; c < m3; ++c) Krow[c] += a0 * h0[c] + a1 * h1[c] + a2 * h2[c];
+                        }
+                }
+            }
+        }
+        thread_energy[t] = energy;
+    }
+    for (int t = 0; t < nth; ++t) energy_total += thread_energy[t];
+    free(thread_energy);
+    if (bad)
+        return sem_error_set(err, SEM_ERR_NUMERIC,
+                             "an element inverted or the state became non-finite (elastic energy "
+                             "undefined)");
+    o->elastic_energy = energy_total;
+    /* reduce in thread order */
+    memcpy(o->grad_z, o->grad_z_thread, nz * sizeof(double));
+    for (int t = 1; t < nth; ++t)
+        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_thread[(size_t)t * nz + k];
+    if (grad_q) sem_csr_multiply_transpose(&d->Pi, o->grad_z, 3, grad_q);
+    if (!want_hessian) return SEM_OK;
+    memcpy(o->Kz, o->Kz_thread, kz * sizeof(double));
+    for (int t = 1; t < nth; ++t) {
+        const double *src = o->Kz_thread + (size_t)t * kz;
+        for (size_t k = 0; k < kz; ++k) o->Kz[k] += src[k];
+    }
+    /* K_q blocks = sum over part pairs Pi_a^T Kz Pi_b per coordinate pair */
+    size_t mg = max_group(o);
+    int fail = 0;
+#pragma omp parallel num_threads(nth) reduction(| : fail)
+    {
+        double *tmp = malloc((size_t)m * mg * sizeof(double));
+        if (!tmp) fail = 1;
+#pragma omp for schedule(dynamic, 4)
+        for (int g = 0; g < o->n_gpairs; ++g) {
+            if (!tmp) continue;
+            size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
+            double *blk = o->K_blocks + 9 * o->gpair_offset[g];
+            memset(blk, 0, 9 * na * nb * sizeof(double));
+            for (int k = o->gpair_pairs_start[g]; k < o->gpair_pairs_start[g + 1]; ++k) {
+                int pr = o->gpair_pairs[k];
+                const double *K = o->Kz + (size_t)pr * m3 * m3;
+                for (int d1 = 0; d1 < 3; ++d1)
+                    for (int d2 = 0; d2 < 3; ++d2)
+                        add_projected(o, o->pair_a[pr], o->pair_b[pr], K + (size_t)(d1 * m) * m3 + d2 * m,
+                                      m3, blk + (size_t)(d1 * 3 + d2) * na * nb, tmp);
+            }
+        }
+        free(tmp);
+    }
+    if (fail) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    return SEM_OK;
+}
+
+/* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all dofs (block form). */
+static void blocks_multiply(const object *o, double cM, double cE, double cK, double cD,
+                            const double *x, double *y)
+{
+    memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], gb = o->gpair_b[g];
+        size_t na = gsize(o, ga), nb = gsize(o, gb);
+        size_t off = o->gpair_offset[g];
+        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
+        for (size_t la = 0; la < na; ++la) {
+            double *ya = y + 3 * (size_t)ca[la];
+            for (size_t lb = 0; lb < nb; ++lb) {
+                const double *xb = x + 3 * (size_t)cb[lb];
+                size_t e = la * nb + lb;
+                double s = cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
+                for (int d = 0; d < 3; ++d) ya[d] += s * xb[d];
+                if (cK != 0 || cD != 0)
+                    for (int d1 = 0; d1 < 3; ++d1)
+                        for (int d2 = 0; d2 < 3; ++d2) {
+                            size_t idx = 9 * off + (size_t)(d1 * 3 + d2) * na * nb + e;
+                            ya[d1] += (cK * o->K_blocks[idx] + cD * o->K0_blocks[idx]) * xb[d2];
+                        }
+            }
+        }
+    }
+}
+
+/* Fills the solver's values with cM M + cE 2 M_eps + cK K + cD K0 on free dofs. */
+static void fill_system(object *o, double cM, double cE, double cK, double cD)
+{
+    double *val = sem_linear_solver_values(o->solver);
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
+        size_t off = o->gpair_offset[g], n = na * nb;
+        for (int dd = 0; dd < 9; ++dd) {
+            int diag = dd / 3 == dd % 3;
+            const int *map = o->map + 9 * off + (size_t)dd * n;
+            const double *K = o->K_blocks + 9 * off + (size_t)dd * n;
+            const double *K0 = o->K0_blocks + 9 * off + (size_t)dd * n;
+            for (size_t e = 0; e < n; ++e) {
+                int pos = map[e];
+                if (pos < 0) continue;
+                double v = cK * K[e] + cD * K0[e];
+                if (diag) v += cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
+                val[pos] = v;
+            }
+        }
+    }
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* loads and prescribed motion                                                         */
+
+static void prescribed_position(const object *o, double t, int c, double out[3])
+{
+    const double *x0 = o->q0 + 3 * c;
+    const sem_prescribe *pr = &o->def.prescribe;
+    if (pr->type == SEM_PRESCRIBE_AFFINE) {
+        const double *A = pr->affine;
+        for (int r = 0; r < 3; ++r) out[r] = A[4 * r] * x0[0] + A[4 * r + 1] * x0[1] + A[4 * r + 2] * x0[2] + A[4 * r + 3];
+        return;
+    }
+    if (pr->type == SEM_PRESCRIBE_ROTATE) {
+        double tt = pr->duration > 0 && t > pr->duration ? pr->duration : t;
+        double ang = pr->rate * tt;
+        double k[3] = {pr->axis_direction[0], pr->axis_direction[1], pr->axis_direction[2]};
+        double kn = sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
+        if (kn > 0)
+            for (int i = 0; i < 3; ++i) k[i] /= kn;
+        double r[3] = {x0[0] - pr->axis_point[0], x0[1] - pr->axis_point[1], x0[2] - pr->axis_point[2]};
+        double cs = cos(ang), sn = sin(ang);
+        double kxr[3] = {k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]};
+        double kdr = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
+        for (int i = 0; i < 3; ++i)
+            out[i] = pr->axis_point[i] + r[i] * cs + kxr[i] * sn + k[i] * kdr * (1 - cs);
+        return;
+    }
+    memcpy(out, o->q + 3 * c, 3 * sizeof(double));
+}
+
+/* External forces at time t: gravity, region loads, point loads (through Gamma^T). */
+static void external_force(const object *o, double t, double *f)
+{
+    size_t n = 3 * (size_t)o->n_ctrl;
+    memcpy(f, o->f_gravity, n * sizeof(double));
+    const sem_discretization *d = o->d;
+    for (int l = 0; l < o->def.n_region_loads; ++l) {
+        const sem_region_load *rl = &o->def.region_loads[l];
+        double s = rl->frequency > 0 ? 0.5 * (1 + sin(2 * M_PI * rl->frequency * t + rl->phase)) : 1.0;
+        for (int p = 0; p < o->n_quad; ++p) {
+            const double *X = d->quad_X + 3 * p;
+            if (X[0] < rl->box[0] || X[1] < rl->box[1] || X[2] < rl->box[2] || X[0] > rl->box[3] ||
+                X[1] > rl->box[4] || X[2] > rl->box[5])
+                continue;
+            double vol = d->quad_volume[p];
+            for (int e = d->Gamma.row_start[p]; e < d->Gamma.row_start[p + 1]; ++e)
+                for (int k = 0; k < 3; ++k)
+                    f[3 * (size_t)d->Gamma.col[e] + k] += d->Gamma.val[e] * vol * s * rl->force_density[k];
+        }
+    }
+    for (int l = 0; l < o->def.n_point_loads; ++l) {
+        /* the force acts at the quadrature point nearest its rest position */
+        const sem_point_load *pl = &o->def.point_loads[l];
+        int best = -1;
+        double bd = INFINITY;
+        for (int p = 0; p < o->n_quad; ++p) {
+            const double *X = d->quad_X + 3 * p;
+            double dd = (X[0] - pl->X[0]) * (X[0] - pl->X[0]) + (X[1] - pl->X[1]) * (X[1] - pl->X[1]) +
+                        (X[2] - pl->X[2]) * (X[2] - pl->X[2]);
+            if (dd < bd) {
+                bd = dd;
+                best = p;
+            }
+        }
+        if (best < 0) continue;
+        for (int e = d->Gamma.row_start[best]; e < d->Gamma.row_start[best + 1]; ++e)
+            for (int k = 0; k < 3; ++k) f[3 * (size_t)d->Gamma.col[e] + k] += d->Gamma.val[e] * pl->force[k];
+    }
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* steppers                                                                            */
+
+static void gather_free(const object *o, const double *full, double *fr)
+{
+    for (int c = 0; c < o->n_ctrl; ++c) {
+        int f = o->free_index[c];
+        if (f < 0) continue;
+        for (int k = 0; k < 3; ++k) fr[3 * f + k] = full[3 * c + k];
+    }
+}
+
+static void scatter_free(const object *o, const double *fr, double *full)
+{
+    for (int c = 0; c < o->n_ctrl; ++c) {
+        int f = o->free_index[c];
+        if (f < 0) continue;
+        for (int k = 0; k < 3; ++k) full[3 * c + k] = fr[3 * f + k];
+    }
+}
+
+static int finite_vec(const double *x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+/* (M + h C + h^2 K) v+ = M v + h f(q), q+ = q + h v+ (the paper's step). */
+static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err)
+{
+    double h = w->def.dt, t1 = w->time + h;
+    size_t n = 3 * (size_t)o->n_ctrl;
+    double a = w->def.rayleigh_mass, b = w->def.rayleigh_stiffness;
+    double *f = malloc(n * sizeof(double)), *g = malloc(n * sizeof(double));
+    double *rhs = malloc(n * sizeof(double)), *tmp = malloc(n * sizeof(double));
+    double *vp = calloc(n, sizeof(double));
+    double *fr = malloc(3 * (size_t)o->n_free * sizeof(double) + 1);
+    sem_status st = SEM_OK;
+    if (!f || !g || !rhs || !tmp || !vp || !fr) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
+    external_force(o, w->time, f);
+    /* f_total = f_ext - grad V - 2 gamma M_eps q */
+    blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
+    for (size_t i = 0; i < n; ++i) f[i] -= g[i] + tmp[i];
+    /* rhs = M v + h f - h C v ... damping enters the matrix: (M + hC + h^2K) v+ = M v + h f */
+    blocks_multiply(o, 1.0, 0, 0, 0, o->v, rhs);
+    for (size_t i = 0; i < n; ++i) rhs[i] += h * f[i];
+    /* prescribed velocities of pinned points */
+    int any_pinned = 0;
+    for (int c = 0; c < o->n_ctrl; ++c) {
+        if (!o->pinned[c]) continue;
+        double x1[3];
+        prescribed_position(o, t1, c, x1);
+        for (int k = 0; k < 3; ++k) vp[3 * c + k] = (x1[k] - o->q[3 * c + k]) / h;
+        any_pinned = 1;
+    }
+    if (any_pinned) {
+        blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vp, tmp);
+        for (size_t i = 0; i < n; ++i) rhs[i] -= tmp[i];
+    }
+    if (o->n_free > 0) {
+        fill_system(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b);
+        if ((st = sem_linear_solver_factorize(o->solver, err)) != SEM_OK) goto done;
+        w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        gather_free(o, rhs, fr);
+        if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
+        scatter_free(o, fr, vp);
+    }
+    if (!finite_vec(vp, n)) {
+        st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
+        goto done;
+    }
+    memcpy(o->v, vp, n * sizeof(double));
+    for (size_t i = 0; i < n; ++i) o->q[i] += h * o->v[i];
+done:
+    free(f);
+    free(g);
+    free(rhs);
+    free(tmp);
+    free(vp);
+    free(fr);
+    return st;
+}
+
+/* Newton on E(q) = 1/(2h^2) |q - q_pred|_M^2 + V(q) + gamma q^T M_eps q - f^T q (+ damping),
+ * or, when h == 0 (statics), E(q) = V(q) + gamma q^T M_eps q - f^T q. */
+static sem_status newton_solve(sem_world *w, object *o, double h, sem_error *err)
+{
+    size_t n = 3 * (size_t)o->n_ctrl;
+    double t1 = w->time + (h > 0 ? h : 0);
+    int dynamic = h > 0;
+    double cM = dynamic ? 1.0 / (h * h) + w->def.rayleigh_mass / h : 0.0;
+    double cD = dynamic ? w->def.rayleigh_stiffness / h : 0.0;
+    double *qn = malloc(n * sizeof(double)), *qpred = malloc(n * sizeof(double));
+    double *f = malloc(n * sizeof(double)), *g = malloc(n * sizeof(double));
+    double *tmp = malloc(n * sizeof(double)), *dq = calloc(n, sizeof(double));
+    double *qtry = malloc(n * sizeof(double));
+    double *fr = malloc(3 * (size_t)o->n_free * sizeof(double) + 1);
+    sem_status st = SEM_OK;
+    if (!qn || !qpred || !f || !g || !tmp || !dq || !qtry || !fr) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    memcpy(qn, o->q, n * sizeof(double));
+    for (size_t i = 0; i < n; ++i) qpred[i] = o->q[i] + (dynamic ? h * o->v[i] : 0);
+    external_force(o, t1, f);
+    /* pinned points go to their prescribed positions at t1 */
+    for (int c = 0; c < o->n_ctrl; ++c)
+        if (o->pinned[c]) prescribed_position(o, t1, c, o->q + 3 * c);
+    if (dynamic)
+        for (int c = 0; c < o->n_ctrl; ++c)
+            if (!o->pinned[c])
+                for (int k = 0; k < 3; ++k) o->q[3 * c + k] = qpred[3 * c + k];
+
+    /* energy of a configuration (free dofs vary); returns +inf if undefined */
+#define ENERGY(qq, out)                                                                    \
+    do {                                                                                   \
+        sem_error e_;                                                                      \
+        if (assemble_elastic(o, (qq), 0, NULL, &e_) != SEM_OK) {                          \
+            (out) = INFINITY;                                                              \
+        } else {                                                                           \
+            double E_ = o->elastic_energy;                                                 \
+            blocks_multiply(o, 0, o->gamma, 0, 0, (qq), tmp);                              \
+            for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * (qq)[i_] * tmp[i_] - f[i_] * (qq)[i_]; \
+            if (dynamic) {                                                                 \
+                for (size_t i_ = 0; i_ < n; ++i_) dq[i_] = (qq)[i_] - qpred[i_];           \
+                blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);                       \
+                for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * dq[i_] * tmp[i_];            \
+                if (cD > 0 || w->def.rayleigh_mass > 0) {                                  \
+                    for (size_t i_ = 0; i_ < n; ++i_) dq[i_] = (qq)[i_] - qn[i_];          \
+                    blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);       \
+                    for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * dq[i_] * tmp[i_];        \
+                }                                                                          \
+            }                                                                              \
+            (out) = E_;                                                                    \
+        }                                                                                  \
+    } while (0)
+
+    double g0norm = -1;
+    int it;
+    for (it = 0; it < w->def.newton_max_iterations; ++it) {
+        if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
+        /* gradient: grad V + 2 gamma M_eps q - f + M (q - q_pred)/h^2 + damping */
+        blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
+        for (size_t i = 0; i < n; ++i) g[i] += tmp[i] - f[i];
+        if (dynamic) {
+            for (size_t i = 0; i < n; ++i) dq[i] = o->q[i] - qpred[i];
+            blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
+            for (size_t i = 0; i < n; ++i) g[i] += tmp[i];
+            if (cD > 0 || w->def.rayleigh_mass > 0) {
+                for (size_t i = 0; i < n; ++i) dq[i] = o->q[i] - qn[i];
+                blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);
+                for (size_t i = 0; i < n; ++i) g[i] += tmp[i];
+            }
+        }
+        gather_free(o, g, fr);
+        double gnorm = 0, fscale = 0;
+        for (int i = 0; i < 3 * o->n_free; ++i) gnorm += fr[i] * fr[i];
+        gnorm = sqrt(gnorm);
+        for (size_t i = 0; i < n; ++i) fscale += f[i] * f[i];
+        fscale = sqrt(fscale);
+        if (g0norm < 0) g0norm = gnorm;
+        double scale = fmax(g0norm, fscale);
+        if (o->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) break;
+        fill_system(o, cM, o->gamma, 1.0, cD);
+        if ((st = sem_linear_solver_factorize(o->solver, err)) != SEM_OK) goto done;
+        w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
+        memset(dq, 0, n * sizeof(double));
+        scatter_free(o, fr, dq);
+        double slope = 0;
+        for (size_t i = 0; i < n; ++i) slope -= dq[i] * g[i];
+        double E0;
+        ENERGY(o->q, E0);
+        double step = 1.0, Et = INFINITY;
+        double *dir = malloc(n * sizeof(double));
+        if (!dir) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        memcpy(dir, dq, n * sizeof(double));
+        for (int ls = 0; ls < 40; ++ls) {
+            for (size_t i = 0; i < n; ++i) qtry[i] = o->q[i] - step * dir[i];
+            ENERGY(qtry, Et);
+            if (Et <= E0 + 1e-4 * step * slope || (isfinite(Et) && fabs(Et - E0) <= 1e-14 * fabs(E0)))
+                break;
+            step *= 0.5;
+        }
+        double dmax = 0;
+        for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
+        free(dir);
+        if (!isfinite(Et)) {
+            st = sem_error_set(err, SEM_ERR_NUMERIC,
+                               "Newton line search found no valid configuration at t = %g", t1);
+            goto done;
+        }
+        memcpy(o->q, qtry, n * sizeof(double));
+        if (dmax <= 1e-14 * (1.0 + fabs(o->q[0]))) {
+            ++it;
+            break;
+        }
+    }
+#undef ENERGY
+    w->last_iterations = it;
+    if (!finite_vec(o->q, n)) {
+        st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
+        goto done;
+    }
+    if (dynamic)
+        for (size_t i = 0; i < n; ++i) o->v[i] = (o->q[i] - qn[i]) / h;
+    else
+        memset(o->v, 0, n * sizeof(double));
+done:
+    free(qn);
+    free(qpred);
+    free(f);
+    free(g);
+    free(tmp);
+    free(dq);
+    free(qtry);
+    free(fr);
+    return st;
+}
+
+sem_status sem_world_step(sem_world *w, sem_error *err)
+{
+    double t0 = omp_get_wtime();
+    w->last_factor_s = 0;
+    w->last_iterations = 0;
+    for (int i = 0; i < w->n_objects; ++i) {
+        object *o = w->objects[i];
+        sem_status st;
+        switch (w->def.integrator) {
+        case SEM_LINEARLY_IMPLICIT_EULER: st = step_linearly_implicit(w, o, err); break;
+        case SEM_IMPLICIT_EULER: st = newton_solve(w, o, w->def.dt, err); break;
+        default: st = newton_solve(w, o, 0.0, err); break;
+        }
+        if (st != SEM_OK) return st;
+    }
+    w->time += w->def.dt;
+    w->step_index++;
+    w->last_step_s = omp_get_wtime() - t0;
+    return SEM_OK;
+}
+
+sem_status sem_world_solve_static(sem_world *w, sem_error *err)
+{
+    int saved = w->def.newton_max_iterations;
+    if (saved < 200) w->def.newton_max_iterations = 200;
+    for (int i = 0; i < w->n_objects; ++i) {
+        sem_status st = newton_solve(w, w->objects[i], 0.0, err);
+        if (st != SEM_OK) {
+            w->def.newton_max_iterations = saved;
+            return st;
+        }
+    }
+    w->def.newton_max_iterations = saved;
+    return SEM_OK;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* queries                                                                             */
+
+double sem_world_time(const sem_world *w) { return w->time; }
+int sem_world_object_count(const sem_world *w) { return w->n_objects; }
+int sem_world_object_dofs(const sem_world *w, int i) { return 3 * w->objects[i]->n_ctrl; }
+const double *sem_world_object_q(const sem_world *w, int i) { return w->objects[i]->q; }
+const double *sem_world_object_velocity(const sem_world *w, int i) { return w->objects[i]->v; }
+double sem_world_last_step_seconds(const sem_world *w) { return w->last_step_s; }
+double sem_world_last_factor_seconds(const sem_world *w) { return w->last_factor_s; }
+int sem_world_last_iterations(const sem_world *w) { return w->last_iterations; }
+
+const char *sem_world_solver_name(const sem_world *w, int i)
+{
+    return w->objects[i]->solver ? sem_linear_solver_name(w->objects[i]->solver) : "none";
+}
+
+double sem_world_object_nnz_percent(const sem_world *w, int i)
+{
+    const object *o = w->objects[i];
+    /* full q-space pattern: group-pair blocks x 9 */
+    double nnz = 9.0 * (double)o->gpair_offset[o->n_gpairs];
+    double n = 3.0 * o->n_ctrl;
+    return 100.0 * nnz / (n * n);
+}
+
+void sem_world_object_set_state(sem_world *w, int i, const double *q, const double *v)
+{
+    object *o = w->objects[i];
+    size_t n = 3 * (size_t)o->n_ctrl;
+    if (q) memcpy(o->q, q, n * sizeof(double));
+    if (v) memcpy(o->v, v, n * sizeof(double));
+}
+
+void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
+{
+    object *o = w->objects[i];
+    const sem_discretization *d = o->d;
+    memset(s, 0, sizeof *s);
+    s->volume = o->volume;
+    s->mass = o->mass;
+    size_t n = 3 * (size_t)o->n_ctrl;
+    double *x = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+    double *v = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+    double *tmp = malloc(n * sizeof(double) + 1);
+    if (!x || !v || !tmp) {
+        free(x);
+        free(v);
+        free(tmp);
+        return;
+    }
+    sem_csr_multiply(&d->Gamma, o->q, 3, x);
+    sem_csr_multiply(&d->Gamma, o->v, 3, v);
+    const double *g = w->def.gravity;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double rv = o->point_rho_vol[p];
+        const double *xp = x + 3 * p, *vp = v + 3 * p;
+        for (int k = 0; k < 3; ++k) {
+            s->center_of_mass[k] += rv * xp[k];
+            s->linear_momentum[k] += rv * vp[k];
+        }
+        s->angular_momentum[0] += rv * (xp[1] * vp[2] - xp[2] * vp[1]);
+        s->angular_momentum[1] += rv * (xp[2] * vp[0] - xp[0] * vp[2]);
+        s->angular_momentum[2] += rv * (xp[0] * vp[1] - xp[1] * vp[0]);
+        s->gravity_energy -= rv * (g[0] * xp[0] + g[1] * xp[1] + g[2] * xp[2]);
+    }
+    if (o->mass > 0)
+        for (int k = 0; k < 3; ++k) s->center_of_mass[k] /= o->mass;
+    /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
+    blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
+    for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
+    blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
+    for (size_t k = 0; k < n; ++k) s->error_energy += 0.5 * o->q[k] * tmp[k];
+    sem_error e;
+    if (assemble_elastic(o, o->q, 0, NULL, &e) == SEM_OK)
+        s->elastic_energy = o->elastic_energy;
+    else
+        s->elastic_energy = INFINITY;
+    free(x);
+    free(v);
+    free(tmp);
+}

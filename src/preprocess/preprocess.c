@@ -1,0 +1,844 @@
+/*
+ * preprocess.c - composes the SEM preprocessing steps (paper Alg. 1) and owns the result.
+ *
+ * sem_preprocess runs the pure steps of steps.h in the paper's order
+ *     sample -> (ray-cast scene) -> quadrature -> weights -> origins -> projection -> operators
+ * and times them as the columns of Table 1:
+ *     sample_s     boundary sampling (Sec. 5) only;
+ *     quad_s       building the Embree scene (tessellation, orientation fix) + the volume
+ *                  quadrature (Sec. 6.3): the scene exists for the ray casts, and the paper's
+ *                  "Quad" column is its ray casting;
+ *     weights_s    blending weights (Sec. 6.1) + deformation origins (Sec. 6.2);
+ *     build_pi_s   hierarchical projection Pi (Eq. 7);
+ *     operators_s  Gamma, gradient rows, M, M_eps (Eq. 12-16), not a column of Table 1.
+ *
+ * The result is plain data (sem_discretization) that can be saved and loaded again. The file
+ * is versioned and carries a hash of the model geometry and of every option that changes the
+ * result, so a simulation never silently runs on operators of another model or setting.
+ *
+ * File layout (native little-endian doubles/ints; a byte-order mark rejects foreign files):
+ *     "SEMDISC\0" | u32 format version | u32 byte-order mark | u64 model/options hash
+ *     | i32 sizes | f64 scalars | arrays, each prefixed by its u64 element count
+ *     | u64 FNV-1a checksum of everything before it.
+ * The reader never trusts a count: every count must equal the one implied by the sizes and
+ * fit in the bytes that remain, and every sparse matrix is checked (monotone row starts,
+ * sorted in-range columns) before it is used.
+ */
+#include "sem/preprocess.h"
+
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "steps.h"
+
+/* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
+_Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
+
+#define SEM_DISC_FORMAT_VERSION 1u
+#define SEM_DISC_BYTE_ORDER 0x01020304u
+static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
+
+/* ------------------------------------------------------------------------------------ */
+/* options                                                                               */
+
+sem_preprocess_options sem_default_preprocess_options(void)
+{
+    sem_preprocess_options o;
+    memset(&o, 0, sizeof o);
+    o.order = 2;
+    o.rays[0] = 10;
+    o.rays[1] = 10;
+    o.ray_axis = 0;
+    o.points_per_interval = 5;
+    o.alpha = 0.0;    /* with sparsity 0: alpha = 0.5 x bbox diagonal (weights step) */
+    o.sparsity = 0.0;
+    o.weight_threshold = 1e-4;
+    o.gamma = 0.0;    /* default kappa E / L (operators step) */
+    o.youngs_modulus = 1e6;
+    o.tessellation = 8;
+    o.threads = 0;
+    return o;
+}
+
+/* Upper bounds that keep a typo from asking for unbounded memory or time. */
+#define MAX_RAYS_PER_AXIS 4096
+#define MAX_POINTS_PER_INTERVAL 10000
+#define MAX_TESSELLATION 1024
+
+static sem_status validate_options(const sem_preprocess_options *o, sem_error *err)
+{
+    if (o->order != 1 && o->order != 2)
+        return sem_error_set(err, SEM_ERR_INVALID, "order must be 1 or 2 (got %d)", o->order);
+    for (int k = 0; k < 2; ++k)
+        if (o->rays[k] < 1 || o->rays[k] > MAX_RAYS_PER_AXIS)
+            return sem_error_set(err, SEM_ERR_INVALID, "rays must be between 1 and %d (got %d x %d)",
+                                 MAX_RAYS_PER_AXIS, o->rays[0], o->rays[1]);
+    if (o->ray_axis < 0 || o->ray_axis > 2)
+        return sem_error_set(err, SEM_ERR_INVALID, "ray axis must be 0 (x), 1 (y) or 2 (z) (got %d)",
+                             o->ray_axis);
+    if (o->points_per_interval < 1 || o->points_per_interval > MAX_POINTS_PER_INTERVAL)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "points per interval must be between 1 and %d (got %d)",
+                             MAX_POINTS_PER_INTERVAL, o->points_per_interval);
+    if (!isfinite(o->alpha) || o->alpha < 0)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "alpha must be > 0 (or 0 for the default rule) (got %g)", o->alpha);
+    if (!isfinite(o->sparsity) || o->sparsity < 0 || o->sparsity >= 1)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "sparsity must be in (0,1) (or 0 for the default rule) (got %g)",
+                             o->sparsity);
+    if (!isfinite(o->weight_threshold) || o->weight_threshold < 0 || o->weight_threshold >= 1)
+        return sem_error_set(err, SEM_ERR_INVALID, "weight threshold must be in [0,1) (got %g)",
+                             o->weight_threshold);
+    if (!isfinite(o->gamma) || o->gamma < 0)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "gamma must be > 0 (or 0 for the default E / L) (got %g)", o->gamma);
+    if (!isfinite(o->youngs_modulus) || o->youngs_modulus <= 0)
+        return sem_error_set(err, SEM_ERR_INVALID, "Young's modulus must be > 0 (got %g)",
+                             o->youngs_modulus);
+    if (o->tessellation < 1 || o->tessellation > MAX_TESSELLATION)
+        return sem_error_set(err, SEM_ERR_INVALID, "tessellation must be between 1 and %d (got %d)",
+                             MAX_TESSELLATION, o->tessellation);
+    if (o->threads < 0)
+        return sem_error_set(err, SEM_ERR_INVALID, "threads must be >= 0 (got %d)", o->threads);
+    return SEM_OK;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* polynomial basis (Eq. 3)                                                              */
+
+void sem_polynomial_basis(int order, const double dX[3], double *b, double *db)
+{
+    const double x = dX[0], y = dX[1], z = dX[2];
+    const int m = order >= 2 ? 10 : 4;
+    if (b) {
+        b[0] = 1.0;
+        b[1] = x;
+        b[2] = y;
+        b[3] = z;
+        if (m == 10) {
+            b[4] = x * y;
+            b[5] = x * z;
+            b[6] = y * z;
+            b[7] = x * x;
+            b[8] = y * y;
+            b[9] = z * z;
+        }
+    }
+    if (db) {
+        memset(db, 0, (size_t)(3 * m) * sizeof *db);
+        for (int e = 0; e < 3; ++e) db[e * m + 1 + e] = 1.0;
+        if (m == 10) {
+            /* d/dX */
+            db[0 * m + 4] = y;
+            db[0 * m + 5] = z;
+            db[0 * m + 7] = 2 * x;
+            /* d/dY */
+            db[1 * m + 4] = x;
+            db[1 * m + 6] = z;
+            db[1 * m + 8] = 2 * y;
+            /* d/dZ */
+            db[2 * m + 5] = x;
+            db[2 * m + 6] = y;
+            db[2 * m + 9] = 2 * z;
+        }
+    }
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* hash (FNV-1a 64)                                                                      */
+
+typedef struct fnv {
+    uint64_t h;
+} fnv;
+
+static void fnv_init(fnv *f) { f->h = 14695981039346656037ull; }
+
+static void fnv_bytes(fnv *f, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    uint64_t h = f->h;
+    for (size_t k = 0; k < n; ++k) {
+        h ^= p[k];
+        h *= 1099511628211ull;
+    }
+    f->h = h;
+}
+
+static void fnv_int(fnv *f, int v)
+{
+    int32_t x = (int32_t)v;
+    fnv_bytes(f, &x, sizeof x);
+}
+
+/* -0.0 hashes as 0.0 so equal numbers give equal hashes. */
+static void fnv_doubles(fnv *f, const double *v, size_t n)
+{
+    if (!v) {
+        fnv_int(f, -1);
+        return;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        double x = v[k] == 0.0 ? 0.0 : v[k];
+        fnv_bytes(f, &x, sizeof x);
+    }
+}
+
+static void hash_curve(fnv *f, const sem_curve *c)
+{
+    fnv_int(f, c->degree);
+    fnv_int(f, c->n_ctrl);
+    if (c->n_ctrl <= 0 || c->degree < 0) return;
+    fnv_doubles(f, c->knots, (size_t)(c->n_ctrl + c->degree + 1));
+    fnv_doubles(f, c->ctrl, (size_t)c->n_ctrl * 3);
+    fnv_doubles(f, c->weights, (size_t)c->n_ctrl);
+    fnv_doubles(f, &c->t0, 1);
+    fnv_doubles(f, &c->t1, 1);
+}
+
+static void hash_loop(fnv *f, const sem_trim_loop *l)
+{
+    fnv_int(f, l->n_curves);
+    for (int k = 0; k < l->n_curves && l->curves; ++k) hash_curve(f, &l->curves[k]);
+}
+
+unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o)
+{
+    fnv f;
+    fnv_init(&f);
+    fnv_bytes(&f, sem_disc_magic, sizeof sem_disc_magic);
+    fnv_int(&f, (int)SEM_DISC_FORMAT_VERSION);
+    if (model) {
+        fnv_int(&f, model->n_parts);
+        for (int i = 0; i < model->n_parts; ++i) {
+            const sem_part *p = &model->parts[i];
+            const sem_surface *s = &p->surface;
+            fnv_int(&f, s->degree_u);
+            fnv_int(&f, s->degree_v);
+            fnv_int(&f, s->n_u);
+            fnv_int(&f, s->n_v);
+            if (s->n_u > 0 && s->n_v > 0 && s->degree_u >= 0 && s->degree_v >= 0) {
+                fnv_doubles(&f, s->knots_u, (size_t)(s->n_u + s->degree_u + 1));
+                fnv_doubles(&f, s->knots_v, (size_t)(s->n_v + s->degree_v + 1));
+                fnv_doubles(&f, s->ctrl, (size_t)s->n_u * s->n_v * 3);
+                fnv_doubles(&f, s->weights, (size_t)s->n_u * s->n_v);
+            }
+            const double range[4] = {s->u0, s->u1, s->v0, s->v1};
+            fnv_doubles(&f, range, 4);
+            fnv_int(&f, p->has_outer);
+            if (p->has_outer) hash_loop(&f, &p->outer);
+            fnv_int(&f, p->n_holes);
+            for (int h = 0; h < p->n_holes && p->holes; ++h) hash_loop(&f, &p->holes[h]);
+        }
+    }
+    if (o) {
+        /* every option that changes the result; not `threads` (results are the same up to
+         * rounding order). */
+        fnv_int(&f, o->order);
+        fnv_int(&f, o->rays[0]);
+        fnv_int(&f, o->rays[1]);
+        fnv_int(&f, o->ray_axis);
+        fnv_int(&f, o->points_per_interval);
+        const double v[5] = {o->alpha, o->sparsity, o->weight_threshold, o->gamma,
+                             o->youngs_modulus};
+        fnv_doubles(&f, v, 5);
+        fnv_int(&f, o->tessellation);
+    }
+    return (unsigned long long)f.h;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* life cycle                                                                            */
+
+void sem_discretization_destroy(sem_discretization *d)
+{
+    if (!d) return;
+    free(d->part_ctrl_offset);
+    free(d->sample_part);
+    free(d->sample_uv);
+    free(d->sample_X);
+    free(d->sample_area);
+    sem_csr_free(&d->J_hat);
+    free(d->quad_X);
+    free(d->quad_volume);
+    free(d->quad_part);
+    sem_csr_free(&d->W);
+    sem_csr_free(&d->W_samples);
+    free(d->origin_X);
+    free(d->part_origin);
+    sem_csr_free(&d->Pi);
+    sem_csr_free(&d->Gamma);
+    sem_csr_free(&d->Grad);
+    sem_csr_free(&d->Gamma_samples);
+    sem_csr_free(&d->M);
+    sem_csr_free(&d->M_eps);
+    free(d);
+}
+
+/* All control points in one plane => every surface lies in it (convex hull property of
+ * NURBS with positive weights) => the model encloses no volume. Checked up front so a single
+ * planar patch gets a clear message whatever the ray caster makes of it. */
+static int model_is_flat(const sem_model *model)
+{
+    double c[3] = {0, 0, 0}, C[9] = {0};
+    size_t n = 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < model->n_parts; ++i) {
+        const sem_surface *s = &model->parts[i].surface;
+        for (int k = 0; k < s->n_u * s->n_v; ++k) {
+            for (int e = 0; e < 3; ++e) {
+                c[e] += s->ctrl[3 * k + e];
+                lo[e] = fmin(lo[e], s->ctrl[3 * k + e]);
+                hi[e] = fmax(hi[e], s->ctrl[3 * k + e]);
+            }
+            n++;
+        }
+    }
+    if (n < 4) return 1;
+    for (int e = 0; e < 3; ++e) c[e] /= (double)n;
+    for (int i = 0; i < model->n_parts; ++i) {
+        const sem_surface *s = &model->parts[i].surface;
+        for (int k = 0; k < s->n_u * s->n_v; ++k) {
+            double d[3];
+            for (int e = 0; e < 3; ++e) d[e] = s->ctrl[3 * k + e] - c[e];
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) C[3 * a + b] += d[a] * d[b];
+        }
+    }
+    double diag2 = 0;
+    for (int e = 0; e < 3; ++e) diag2 += (hi[e] - lo[e]) * (hi[e] - lo[e]);
+    if (!(diag2 > 0)) return 1;
+    /* smallest eigenvalue of the scatter matrix by the closed form for symmetric 3x3
+     * (Smith 1961): flat when the spread normal to the best plane is ~0. */
+    double p1 = C[1] * C[1] + C[2] * C[2] + C[5] * C[5];
+    double q = (C[0] + C[4] + C[8]) / 3.0;
+    double p2 = (C[0] - q) * (C[0] - q) + (C[4] - q) * (C[4] - q) + (C[8] - q) * (C[8] - q) + 2 * p1;
+    double lmin;
+    if (p2 <= 0) {
+        lmin = q;
+    } else {
+        double p = sqrt(p2 / 6.0), B[9];
+        for (int k = 0; k < 9; ++k) B[k] = (C[k] - (k % 4 == 0 ? q : 0.0)) / p;
+        double detB = B[0] * (B[4] * B[8] - B[5] * B[7]) - B[1] * (B[3] * B[8] - B[5] * B[6]) +
+                      B[2] * (B[3] * B[7] - B[4] * B[6]);
+        double r = fmax(-1.0, fmin(1.0, detB / 2.0));
+        double phi = acos(r) / 3.0;
+        lmin = q + 2 * p * cos(phi + 2.0 * M_PI / 3.0);
+    }
+    /* lmin / n is the mean squared distance to the best plane */
+    return lmin / (double)n <= 1e-20 * diag2;
+}
+
+sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *options,
+                          sem_discretization **out, sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!model || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_preprocess: NULL argument");
+    sem_preprocess_options o = options ? *options : sem_default_preprocess_options();
+    sem_status st = validate_options(&o, err);
+    if (st != SEM_OK) return st;
+    if (model->n_parts <= 0) return sem_error_set(err, SEM_ERR_INVALID, "model has no parts");
+    for (int i = 0; i < model->n_parts; ++i) {
+        sem_error e2;
+        if (sem_surface_validate(&model->parts[i].surface, &e2) != SEM_OK)
+            return sem_error_set(err, SEM_ERR_INVALID, "part %d: %s", i, e2.message);
+    }
+    if (model_is_flat(model))
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "model encloses no volume (all its surfaces lie in one plane)");
+
+    int saved_threads = omp_get_max_threads();
+    if (o.threads > 0) omp_set_num_threads(o.threads);
+
+    sem_discretization *d = calloc(1, sizeof *d);
+    sem_raycast_scene *scene = NULL;
+    if (!d) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    d->order = o.order;
+    d->n_basis = o.order == 1 ? 4 : 10;
+    d->model_hash = sem_preprocess_hash(model, &o);
+
+    double t0 = omp_get_wtime();
+    st = sem_step_sample(model, d, err);
+    if (st != SEM_OK) goto done;
+    double t1 = omp_get_wtime();
+    d->timings.sample_s = t1 - t0;
+
+    st = sem_raycast_scene_build(model, o.tessellation, &scene, err);
+    if (st != SEM_OK) goto done;
+    st = sem_step_quadrature(model, scene, &o, d, err);
+    if (st != SEM_OK) goto done;
+    double t2 = omp_get_wtime();
+    d->timings.quad_s = t2 - t1;
+    if (d->n_quad <= 0 || !(d->volume > 0)) {
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "model encloses no volume (no ray of the %d x %d grid found an inside)",
+                           o.rays[0], o.rays[1]);
+        goto done;
+    }
+
+    st = sem_step_weights(model, scene, &o, d, err);
+    if (st != SEM_OK) goto done;
+    st = sem_step_origins(model, d, err);
+    if (st != SEM_OK) goto done;
+    double t3 = omp_get_wtime();
+    d->timings.weights_s = t3 - t2;
+
+    st = sem_step_projection(&o, d, err);
+    if (st != SEM_OK) goto done;
+    double t4 = omp_get_wtime();
+    d->timings.build_pi_s = t4 - t3;
+
+    st = sem_step_operators(&o, d, err);
+    if (st != SEM_OK) goto done;
+    d->timings.operators_s = omp_get_wtime() - t4;
+
+done:
+    sem_raycast_scene_destroy(scene);
+    if (o.threads > 0) omp_set_num_threads(saved_threads);
+    if (st != SEM_OK) {
+        sem_discretization_destroy(d);
+        return st;
+    }
+    *out = d;
+    return SEM_OK;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* save                                                                                  */
+
+typedef struct writer {
+    FILE *f;
+    fnv sum;
+    int failed;
+} writer;
+
+static void w_bytes(writer *w, const void *data, size_t n)
+{
+    if (w->failed || n == 0) return;
+    fnv_bytes(&w->sum, data, n);
+    if (fwrite(data, 1, n, w->f) != n) w->failed = 1;
+}
+
+static void w_u32(writer *w, uint32_t v) { w_bytes(w, &v, sizeof v); }
+static void w_u64(writer *w, uint64_t v) { w_bytes(w, &v, sizeof v); }
+static void w_i32(writer *w, int v)
+{
+    int32_t x = (int32_t)v;
+    w_bytes(w, &x, sizeof x);
+}
+static void w_f64(writer *w, double v) { w_bytes(w, &v, sizeof v); }
+
+static void w_ints(writer *w, const int *v, size_t n)
+{
+    w_u64(w, (uint64_t)n);
+    if (n && v) {
+        w_bytes(w, v, n * sizeof(int));
+    }
+}
+
+static void w_doubles(writer *w, const double *v, size_t n)
+{
+    w_u64(w, (uint64_t)n);
+    if (n && v) w_bytes(w, v, n * sizeof(double));
+}
+
+static void w_csr(writer *w, const sem_csr *m)
+{
+    size_t nnz = m->row_start ? sem_csr_nnz(m) : 0;
+    w_i32(w, m->n_rows);
+    w_i32(w, m->n_cols);
+    if (!m->row_start) {
+        /* an empty matrix: row starts all 0 */
+        w_u64(w, (uint64_t)m->n_rows + 1);
+        for (int r = 0; r <= m->n_rows; ++r) w_i32(w, 0);
+    } else {
+        w_ints(w, m->row_start, (size_t)m->n_rows + 1);
+    }
+    w_ints(w, m->col, nnz);
+    w_doubles(w, m->val, nnz);
+}
+
+sem_status sem_discretization_save(const sem_discretization *d, const char *path, sem_error *err)
+{
+    if (!d || !path) return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_save: NULL argument");
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 64);
+    if (!tmp) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    snprintf(tmp, len + 64, "%s.tmp%ld", path, (long)getpid());
+    writer w = {fopen(tmp, "wb"), {0}, 0};
+    if (!w.f) {
+        sem_status st = sem_error_set(err, SEM_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        free(tmp);
+        return st;
+    }
+    fnv_init(&w.sum);
+    w_bytes(&w, sem_disc_magic, sizeof sem_disc_magic);
+    w_u32(&w, SEM_DISC_FORMAT_VERSION);
+    w_u32(&w, SEM_DISC_BYTE_ORDER);
+    w_u64(&w, (uint64_t)d->model_hash);
+    w_i32(&w, d->order);
+    w_i32(&w, d->n_basis);
+    w_i32(&w, d->n_parts);
+    w_i32(&w, d->n_ctrl);
+    w_i32(&w, d->n_samples);
+    w_i32(&w, d->n_quad);
+    w_i32(&w, d->n_origins);
+    w_f64(&w, d->volume);
+    w_f64(&w, d->alpha);
+    w_f64(&w, d->gamma);
+    w_f64(&w, d->length_scale);
+    w_f64(&w, d->stiffness_nnz_percent);
+    w_f64(&w, d->weight_nonzero_fraction);
+    w_f64(&w, d->timings.sample_s);
+    w_f64(&w, d->timings.quad_s);
+    w_f64(&w, d->timings.weights_s);
+    w_f64(&w, d->timings.build_pi_s);
+    w_f64(&w, d->timings.operators_s);
+
+    w_ints(&w, d->part_ctrl_offset, d->part_ctrl_offset ? (size_t)d->n_parts + 1 : 0);
+    w_ints(&w, d->sample_part, d->sample_part ? (size_t)d->n_samples : 0);
+    w_doubles(&w, d->sample_uv, d->sample_uv ? 2 * (size_t)d->n_samples : 0);
+    w_doubles(&w, d->sample_X, d->sample_X ? 3 * (size_t)d->n_samples : 0);
+    w_doubles(&w, d->sample_area, d->sample_area ? (size_t)d->n_samples : 0);
+    w_csr(&w, &d->J_hat);
+    w_doubles(&w, d->quad_X, d->quad_X ? 3 * (size_t)d->n_quad : 0);
+    w_doubles(&w, d->quad_volume, d->quad_volume ? (size_t)d->n_quad : 0);
+    w_ints(&w, d->quad_part, d->quad_part ? (size_t)d->n_quad : 0);
+    w_csr(&w, &d->W);
+    w_csr(&w, &d->W_samples);
+    w_doubles(&w, d->origin_X, d->origin_X ? 3 * (size_t)d->n_origins : 0);
+    w_ints(&w, d->part_origin, d->part_origin ? (size_t)d->n_parts : 0);
+    w_csr(&w, &d->Pi);
+    w_csr(&w, &d->Gamma);
+    w_csr(&w, &d->Grad);
+    w_csr(&w, &d->Gamma_samples);
+    w_csr(&w, &d->M);
+    w_csr(&w, &d->M_eps);
+    uint64_t sum = w.sum.h;
+    w_u64(&w, sum);
+
+    int failed = w.failed;
+    if (fflush(w.f) != 0) failed = 1;
+    if (!failed && fsync(fileno(w.f)) != 0) failed = 1;
+    if (fclose(w.f) != 0) failed = 1;
+    if (failed) {
+        sem_status st = sem_error_set(err, SEM_ERR_IO, "%s: write failed: %s", path, strerror(errno));
+        remove(tmp);
+        free(tmp);
+        return st;
+    }
+    if (rename(tmp, path) != 0) {
+        sem_status st =
+            sem_error_set(err, SEM_ERR_IO, "%s: cannot replace: %s", path, strerror(errno));
+        remove(tmp);
+        free(tmp);
+        return st;
+    }
+    free(tmp);
+    return SEM_OK;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* load                                                                                  */
+
+typedef struct reader {
+    const unsigned char *data;
+    size_t size, pos;
+    const char *path;
+    sem_error *err;
+    sem_status st;
+} reader;
+
+static int r_fail(reader *r, const char *what)
+{
+    if (r->st == SEM_OK)
+        r->st = sem_error_set(r->err, SEM_ERR_PARSE, "%s: corrupt preprocessed data: %s", r->path,
+                              what);
+    return 0;
+}
+
+static int r_bytes(reader *r, void *out, size_t n)
+{
+    if (r->st != SEM_OK) return 0;
+    if (n > r->size - r->pos) return r_fail(r, "file is truncated");
+    memcpy(out, r->data + r->pos, n);
+    r->pos += n;
+    return 1;
+}
+
+static uint32_t r_u32(reader *r)
+{
+    uint32_t v = 0;
+    r_bytes(r, &v, sizeof v);
+    return v;
+}
+static uint64_t r_u64(reader *r)
+{
+    uint64_t v = 0;
+    r_bytes(r, &v, sizeof v);
+    return v;
+}
+static int r_i32(reader *r)
+{
+    int32_t v = 0;
+    r_bytes(r, &v, sizeof v);
+    return (int)v;
+}
+static double r_f64(reader *r)
+{
+    double v = 0;
+    r_bytes(r, &v, sizeof v);
+    return v;
+}
+
+/* Reads an array whose element count must be `expected`; checks the bytes exist before
+ * allocating. Returns NULL for an empty array (and on failure, with r->st set). */
+static void *r_array(reader *r, size_t expected, size_t elem, const char *what)
+{
+    uint64_t n = r_u64(r);
+    if (r->st != SEM_OK) return NULL;
+    if (n != (uint64_t)expected) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "%s has %llu entries, expected %llu", what,
+                 (unsigned long long)n, (unsigned long long)expected);
+        r_fail(r, msg);
+        return NULL;
+    }
+    if (n == 0) return NULL;
+    if (n > (r->size - r->pos) / elem) {
+        r_fail(r, "file is truncated");
+        return NULL;
+    }
+    void *p = malloc((size_t)n * elem);
+    if (!p) {
+        r->st = sem_error_set(r->err, SEM_ERR_NOMEM, "%s: out of memory", r->path);
+        return NULL;
+    }
+    r_bytes(r, p, (size_t)n * elem);
+    return p;
+}
+
+static int *r_ints(reader *r, size_t expected, const char *what)
+{
+    return r_array(r, expected, sizeof(int32_t), what);
+}
+static double *r_doubles(reader *r, size_t expected, const char *what)
+{
+    return r_array(r, expected, sizeof(double), what);
+}
+
+static void r_csr(reader *r, sem_csr *m, int n_rows, int n_cols, const char *what)
+{
+    memset(m, 0, sizeof *m);
+    int rows = r_i32(r), cols = r_i32(r);
+    if (r->st != SEM_OK) return;
+    if (rows != n_rows || cols != n_cols) {
+        char msg[200];
+        snprintf(msg, sizeof msg, "%s is %d x %d, expected %d x %d", what, rows, cols, n_rows,
+                 n_cols);
+        r_fail(r, msg);
+        return;
+    }
+    m->n_rows = rows;
+    m->n_cols = cols;
+    m->row_start = r_ints(r, (size_t)rows + 1, what);
+    if (r->st != SEM_OK) return;
+    if (!m->row_start || m->row_start[0] != 0) {
+        r_fail(r, "bad sparse row starts");
+        return;
+    }
+    for (int k = 0; k < rows; ++k)
+        if (m->row_start[k + 1] < m->row_start[k]) {
+            r_fail(r, "bad sparse row starts");
+            return;
+        }
+    size_t nnz = (size_t)m->row_start[rows];
+    m->col = r_ints(r, nnz, what);
+    m->val = r_doubles(r, nnz, what);
+    if (r->st != SEM_OK) return;
+    if (nnz == 0) {
+        /* keep the invariant of sem_csr_alloc: col/val are allocated */
+        m->col = malloc(sizeof(int));
+        m->val = malloc(sizeof(double));
+        if (!m->col || !m->val) {
+            r->st = sem_error_set(r->err, SEM_ERR_NOMEM, "%s: out of memory", r->path);
+            return;
+        }
+    }
+    for (int k = 0; k < rows; ++k)
+        for (int j = m->row_start[k]; j < m->row_start[k + 1]; ++j) {
+            if (m->col[j] < 0 || m->col[j] >= cols ||
+                (j > m->row_start[k] && m->col[j] <= m->col[j - 1])) {
+                r_fail(r, "sparse column out of range or unsorted");
+                return;
+            }
+            if (!isfinite(m->val[j])) {
+                r_fail(r, "non-finite value");
+                return;
+            }
+        }
+}
+
+static int check_index_array(reader *r, const int *v, size_t n, int limit, const char *what)
+{
+    for (size_t k = 0; k < n && v; ++k)
+        if (v[k] < 0 || v[k] >= limit) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "%s index out of range", what);
+            return r_fail(r, msg);
+        }
+    return 1;
+}
+
+sem_status sem_discretization_load(const char *path, unsigned long long expected_hash,
+                                   sem_discretization **out, sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!path || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_load: NULL argument");
+    FILE *f = fopen(path, "rb");
+    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return sem_error_set(err, SEM_ERR_IO, "%s: not a regular file", path);
+    }
+    size_t size = (size_t)sb.st_size;
+    const size_t header = sizeof sem_disc_magic + 4 + 4 + 8;
+    if (size < header + 8) {
+        fclose(f);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (too short)", path);
+    }
+    unsigned char *data = malloc(size);
+    if (!data) {
+        fclose(f);
+        return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, size);
+    }
+    size_t got = fread(data, 1, size, f);
+    fclose(f);
+    if (got != size) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_IO, "%s: read failed", path);
+    }
+
+    reader r = {data, size, 0, path, err, SEM_OK};
+    char magic[8];
+    r_bytes(&r, magic, sizeof magic);
+    if (memcmp(magic, sem_disc_magic, sizeof magic) != 0) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (bad magic)", path);
+    }
+    uint32_t version = r_u32(&r);
+    uint32_t bom = r_u32(&r);
+    if (bom != SEM_DISC_BYTE_ORDER) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s: written on a machine of another byte order",
+                             path);
+    }
+    if (version != SEM_DISC_FORMAT_VERSION) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s: written by format version %u, this sem reads %u",
+                             path, (unsigned)version, (unsigned)SEM_DISC_FORMAT_VERSION);
+    }
+    /* checksum of everything before the last 8 bytes */
+    fnv sum;
+    fnv_init(&sum);
+    fnv_bytes(&sum, data, size - 8);
+    uint64_t stored;
+    memcpy(&stored, data + size - 8, 8);
+    if (stored != sum.h) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_PARSE,
+                             "%s: corrupt preprocessed data: checksum mismatch (truncated or damaged file)",
+                             path);
+    }
+    uint64_t hash = r_u64(&r);
+    if (expected_hash != 0 && hash != (uint64_t)expected_hash) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "%s: preprocessed data is for a different model or settings", path);
+    }
+    r.size = size - 8; /* the checksum is not content */
+
+    sem_discretization *d = calloc(1, sizeof *d);
+    if (!d) {
+        free(data);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    d->model_hash = hash;
+    d->order = r_i32(&r);
+    d->n_basis = r_i32(&r);
+    d->n_parts = r_i32(&r);
+    d->n_ctrl = r_i32(&r);
+    d->n_samples = r_i32(&r);
+    d->n_quad = r_i32(&r);
+    d->n_origins = r_i32(&r);
+    if (r.st == SEM_OK &&
+        ((d->order != 1 && d->order != 2) || d->n_basis != (d->order == 1 ? 4 : 10) ||
+         d->n_parts < 0 || d->n_ctrl < 0 || d->n_samples < 0 || d->n_quad < 0 ||
+         d->n_origins < 0 || d->n_quad > INT32_MAX / 3 || d->n_parts > INT32_MAX / 10))
+        r_fail(&r, "bad sizes");
+    d->volume = r_f64(&r);
+    d->alpha = r_f64(&r);
+    d->gamma = r_f64(&r);
+    d->length_scale = r_f64(&r);
+    d->stiffness_nnz_percent = r_f64(&r);
+    d->weight_nonzero_fraction = r_f64(&r);
+    d->timings.sample_s = r_f64(&r);
+    d->timings.quad_s = r_f64(&r);
+    d->timings.weights_s = r_f64(&r);
+    d->timings.build_pi_s = r_f64(&r);
+    d->timings.operators_s = r_f64(&r);
+
+    if (r.st == SEM_OK) {
+        size_t P = (size_t)d->n_parts, S = (size_t)d->n_samples, Q = (size_t)d->n_quad;
+        d->part_ctrl_offset = r_ints(&r, P + 1, "part_ctrl_offset");
+        d->sample_part = r_ints(&r, S, "sample_part");
+        d->sample_uv = r_doubles(&r, 2 * S, "sample_uv");
+        d->sample_X = r_doubles(&r, 3 * S, "sample_X");
+        d->sample_area = r_doubles(&r, S, "sample_area");
+        r_csr(&r, &d->J_hat, d->n_samples, d->n_ctrl, "J_hat");
+        d->quad_X = r_doubles(&r, 3 * Q, "quad_X");
+        d->quad_volume = r_doubles(&r, Q, "quad_volume");
+        d->quad_part = r_ints(&r, Q, "quad_part");
+        r_csr(&r, &d->W, d->n_quad, d->n_parts, "W");
+        r_csr(&r, &d->W_samples, d->n_samples, d->n_parts, "W_samples");
+        d->origin_X = r_doubles(&r, 3 * (size_t)d->n_origins, "origin_X");
+        d->part_origin = r_ints(&r, P, "part_origin");
+        r_csr(&r, &d->Pi, d->n_parts * d->n_basis, d->n_ctrl, "Pi");
+        r_csr(&r, &d->Gamma, d->n_quad, d->n_ctrl, "Gamma");
+        r_csr(&r, &d->Grad, 3 * d->n_quad, d->n_ctrl, "Grad");
+        r_csr(&r, &d->Gamma_samples, d->n_samples, d->n_ctrl, "Gamma_samples");
+        r_csr(&r, &d->M, d->n_ctrl, d->n_ctrl, "M");
+        r_csr(&r, &d->M_eps, d->n_ctrl, d->n_ctrl, "M_eps");
+    }
+    if (r.st == SEM_OK && r.pos != r.size) r_fail(&r, "trailing bytes");
+    if (r.st == SEM_OK) {
+        check_index_array(&r, d->sample_part, (size_t)d->n_samples, d->n_parts, "sample_part");
+        check_index_array(&r, d->quad_part, (size_t)d->n_quad, d->n_parts, "quad_part");
+        check_index_array(&r, d->part_origin, (size_t)d->n_parts, d->n_origins, "part_origin");
+        if (d->part_ctrl_offset) {
+            if (d->part_ctrl_offset[0] != 0 || d->part_ctrl_offset[d->n_parts] != d->n_ctrl)
+                r_fail(&r, "bad part_ctrl_offset");
+            for (int i = 0; i < d->n_parts && r.st == SEM_OK; ++i)
+                if (d->part_ctrl_offset[i + 1] < d->part_ctrl_offset[i])
+                    r_fail(&r, "bad part_ctrl_offset");
+        }
+    }
+    free(data);
+    if (r.st != SEM_OK) {
+        sem_discretization_destroy(d);
+        return r.st;
+    }
+    *out = d;
+    return SEM_OK;
+}

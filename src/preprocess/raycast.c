@@ -1,0 +1,1083 @@
+/*
+ * raycast.c - Embree ray casting against a tessellation of the model's parts (Sec. 6.3).
+ *
+ * Design
+ * - One Embree triangle geometry per part, attached with geomID = part index, so a hit's
+ *   geomID is the part directly. Parts whose tessellation is empty (fully trimmed away)
+ *   simply have no geometry. The scene uses RTC_SCENE_FLAG_ROBUST (watertight traversal:
+ *   a ray through a shared edge hits at least one of the two triangles) and
+ *   RTC_BUILD_QUALITY_HIGH (spatial splits: faster traversal; a triangle may then be
+ *   reported twice, which the all-hits query removes).
+ * - Precision. Embree works in single precision. We keep the tessellation in double and
+ *   recompute every hit distance in double as the ray-plane distance of the hit triangle:
+ *   t = ((v0 - o) . n) / (d . n). So a hit's t is exact to double rounding for the
+ *   triangle that was hit; only the *decision* whether a ray passes just inside or just
+ *   outside a triangle (within ~1e-7 of the model size of an edge) is made in float.
+ *   Degenerate triangles (zero area in double) are dropped when the scene is built, so
+ *   every triangle has a unit normal.
+ * - All hits: one rtcIntersect1 per ray with a context filter function that records every
+ *   candidate and rejects it (so traversal continues to the end of the ray). Then, in
+ *   double: sort by t; hits of one part closer than 1e-7 x (bounding-box diagonal) form a
+ *   cluster (a ray through a shared edge or vertex hits 2+ triangles, spatial splits give
+ *   duplicates); a cluster counts as one crossing in the direction of its net facing
+ *   (entering minus leaving) and vanishes when that is zero (a ray grazing a fold touches
+ *   the surface without crossing it). Within one t, entering hits sort before leaving ones,
+ *   so touching solids make one union interval.
+ * - Orientation fix (part_sign). CAD files have inward faces. For each part we pick up to
+ *   9 sample triangles (the largest triangle of each of 9 equal slices of the part's
+ *   triangle list, so the samples spread over the part) and cast 5 rays from each centre:
+ *   along the normal and 4 directions 25 degrees off it. A ray that leaves a closed solid
+ *   crosses its boundary an even number of times (0, 2, ...) before escaping, a ray that
+ *   points into the solid an odd number of times. Each ray votes +area (even: the normal
+ *   points out) or -area (odd); the sign of the sum decides, ties keep +1. Rays, not one
+ *   ray, because a ray may escape through a gap or the open end of an open model (the
+ *   rocket has no bottom) or cross an embedded part (the mug's handle): a majority of
+ *   jittered rays from several places is robust to such accidents.
+ * - Generalized winding number (Jacobson et al. 2013): the sum over the orientation-
+ *   corrected triangles of their signed solid angles seen from X (Van Oosterom & Strackee
+ *   1983: tan(Omega/2) = det[a b c] / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|)),
+ *   divided by 4 pi. Exact, O(triangles) per query; the quadrature only calls it for the
+ *   segments of rays whose enter/leave counting is inconsistent, and callers thread over
+ *   queries (the function is re-entrant).
+ * - Closest parts: rtcPointQuery with a callback that computes the exact double-precision
+ *   point-triangle distance (Ericson, Real-Time Collision Detection, 5.1.5) and keeps the
+ *   minimum per part within the radius, in a per-call context (thread-safe).
+ */
+#include "raycast.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sem/nurbs.h"
+#include "sem/tessellate.h"
+
+/* The tessellation as this file uses it: vertices (3 doubles each) and triangles (3
+ * vertex indices each) with the part of each triangle. */
+typedef struct raw_mesh {
+    int n_vertices;
+    double *vertices;
+    double *uv; /* 2 per vertex: the part's (u,v) */
+    int n_triangles;
+    int *triangles;
+    int *triangle_part;
+} raw_mesh;
+
+static void raw_mesh_free(raw_mesh *m)
+{
+    free(m->vertices);
+    free(m->uv);
+    free(m->triangles);
+    free(m->triangle_part);
+    memset(m, 0, sizeof *m);
+}
+
+/* The shared tessellation (sem/tessellate.h): trimmed parts keep the triangles whose (u,v)
+ * centroid is inside the trim. */
+static sem_status tessellate(const sem_model *model, int resolution, raw_mesh *out,
+                             sem_error *err)
+{
+    memset(out, 0, sizeof *out);
+    sem_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    sem_status st = sem_mesh_from_model(model, resolution, &mesh, err);
+    if (st != SEM_OK) {
+        sem_mesh_free(&mesh);
+        return st;
+    }
+    out->n_vertices = mesh.n_vertices;
+    out->vertices = mesh.positions;
+    out->uv = mesh.uv;
+    out->n_triangles = mesh.n_triangles;
+    out->triangles = mesh.triangles;
+    out->triangle_part = mesh.triangle_part;
+    mesh.positions = NULL;
+    mesh.uv = NULL;
+    mesh.triangles = NULL;
+    mesh.triangle_part = NULL;
+    sem_mesh_free(&mesh);
+    if (out->n_triangles > 0 && (!out->vertices || !out->uv || !out->triangles ||
+                                 !out->triangle_part)) {
+        raw_mesh_free(out);
+        return sem_error_set(err, SEM_ERR_INVALID, "raycast: incomplete tessellation");
+    }
+    return SEM_OK;
+}
+
+struct sem_raycast_scene {
+    RTCDevice device;
+    RTCScene scene;
+    int n_parts;
+    int *part_sign;       /* n_parts, +1/-1 */
+    int *part_tri_offset; /* n_parts + 1: part i owns triangles [off[i], off[i+1]) */
+    int n_triangles;
+    double *tri;          /* 9 per triangle: v0, v1, v2 */
+    double *tri_normal;   /* 3 per triangle: unit (v1-v0)x(v2-v0), before the fix */
+    double *tri_area;     /* per triangle */
+    double *tri_uv;       /* 6 per triangle: (u,v) of v0, v1, v2 */
+    sem_surface *surfaces; /* copies of the parts' surfaces, for exact hit refinement */
+    double lo[3], hi[3];
+    double scale;         /* bounding-box diagonal (> 0) */
+    double merge_eps;     /* hits of one part closer than this are one crossing */
+};
+
+/* ---- small vector helpers ---- */
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void sub3(const double *a, const double *b, double *r)
+{
+    r[0] = a[0] - b[0];
+    r[1] = a[1] - b[1];
+    r[2] = a[2] - b[2];
+}
+static void cross3(const double *a, const double *b, double *r)
+{
+    r[0] = a[1] * b[2] - a[2] * b[1];
+    r[1] = a[2] * b[0] - a[0] * b[2];
+    r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* ---- all-hits collection ---- */
+
+#define LOCAL_HITS 64
+
+typedef struct hit_collector {
+    struct RTCIntersectContext context; /* first: Embree hands our pointer back */
+    const sem_raycast_scene *scene;
+    double origin[3], dir[3];
+    int use_sign; /* 0 while part_sign is being estimated */
+    sem_ray_hit *hits;
+    int n, cap;
+    int failed;   /* out of memory */
+    sem_ray_hit local[LOCAL_HITS];
+} hit_collector;
+
+/* Exact hit on the NURBS surface: Newton on S(u,v) - (o + t d) = 0 started from the
+ * triangle's (u,v) at the hit (barycentric interpolation of its vertices' (u,v)). Returns 1
+ * and the exact t when it converges within the triangle's size of the triangle hit
+ * (otherwise, e.g. at a collapsed pole or for a grazing ray, the triangle's t stays). */
+static int refine_hit(const sem_raycast_scene *s, int part, int global, const double *o,
+                      const double *d, double t_tri, double *t_out)
+{
+    const double *v = s->tri + 9 * (size_t)global;
+    const double *uv = s->tri_uv + 6 * (size_t)global;
+    const sem_surface *S = &s->surfaces[part];
+    double e1[3], e2[3], w[3], p[3];
+    for (int k = 0; k < 3; k++) p[k] = o[k] + t_tri * d[k];
+    sub3(v + 3, v, e1);
+    sub3(v + 6, v, e2);
+    sub3(p, v, w);
+    double d00 = dot3(e1, e1), d01 = dot3(e1, e2), d11 = dot3(e2, e2);
+    double d20 = dot3(w, e1), d21 = dot3(w, e2);
+    double den = d00 * d11 - d01 * d01;
+    if (!(den > 0)) return 0;
+    double b1 = (d11 * d20 - d01 * d21) / den, b2 = (d00 * d21 - d01 * d20) / den;
+    double b0 = 1.0 - b1 - b2;
+    double u = b0 * uv[0] + b1 * uv[2] + b2 * uv[4];
+    double vv = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+    double t = t_tri;
+    double size = sqrt(d00 > d11 ? d00 : d11);
+    double tol = 1e-13 * s->scale;
+    for (int it = 0; it < 16; it++) {
+        double X[3], Su[3], Sv[3], F[3], c[3] = {-d[0], -d[1], -d[2]};
+        sem_surface_eval(S, u, vv, X, Su, Sv, NULL);
+        for (int k = 0; k < 3; k++) F[k] = X[k] - o[k] - t * d[k];
+        if (sqrt(dot3(F, F)) <= tol) {
+            if (fabs(t - t_tri) > size) return 0;
+            *t_out = t;
+            return 1;
+        }
+        double bc[3], rhs[3] = {-F[0], -F[1], -F[2]}, tmp[3];
+        cross3(Su, c, tmp); /* unused order check below uses Cramer's rule on [Su Sv c] */
+        cross3(Sv, c, bc);
+        double det = dot3(Su, bc);
+        double scale = sqrt(dot3(Su, Su) * dot3(Sv, Sv));
+        if (!(fabs(det) > 1e-10 * scale)) return 0;
+        double du = dot3(rhs, bc) / det;
+        cross3(rhs, c, tmp);
+        double dv = dot3(Su, tmp) / det;
+        cross3(Sv, rhs, tmp);
+        double dt = dot3(Su, tmp) / det;
+        u += du;
+        vv += dv;
+        t += dt;
+        if (u < S->u0) u = S->u0;
+        if (u > S->u1) u = S->u1;
+        if (vv < S->v0) vv = S->v0;
+        if (vv > S->v1) vv = S->v1;
+        if (!isfinite(t) || fabs(t - t_tri) > 4 * size) return 0;
+    }
+    return 0;
+}
+
+/* Fills a hit from triangle `global` of `part`, with t recomputed in double (ray-plane
+ * distance, or the exact surface hit when refine is set); falls back to Embree's t for a
+ * ray (nearly) in the triangle's plane. */
+static void make_hit(const sem_raycast_scene *s, const double *o, const double *d, int part,
+                     int global, int prim, double embree_t, int use_sign, int refine,
+                     sem_ray_hit *h)
+{
+    const double *v0 = s->tri + 9 * (size_t)global;
+    const double *n = s->tri_normal + 3 * (size_t)global;
+    double w[3];
+    sub3(v0, o, w);
+    double dn = dot3(d, n);
+    double t = embree_t;
+    if (fabs(dn) > 1e-12) t = dot3(w, n) / dn;
+    if (refine) {
+        double te;
+        if (refine_hit(s, part, global, o, d, t, &te)) t = te;
+    }
+    double sign = use_sign ? (double)s->part_sign[part] : 1.0;
+    h->t = t;
+    h->part = part;
+    h->triangle = prim;
+    h->normal[0] = sign * n[0];
+    h->normal[1] = sign * n[1];
+    h->normal[2] = sign * n[2];
+}
+
+static void collect_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    hit_collector *c = (hit_collector *)args->context;
+    for (unsigned int i = 0; i < args->N; i++) {
+        if (args->valid[i] != -1) continue;
+        args->valid[i] = 0; /* reject: traversal goes on and reports every hit */
+        /* SOA layout of RTCRayN/RTCHitN (the C++ accessors of rtcore_ray.h, in C) */
+        unsigned int N = args->N;
+        unsigned int geom = ((const unsigned *)args->hit)[6 * N + i];
+        unsigned int prim = ((const unsigned *)args->hit)[5 * N + i];
+        float tf = ((const float *)args->ray)[8 * N + i];
+        const sem_raycast_scene *s = c->scene;
+        if (geom >= (unsigned int)s->n_parts) continue;
+        int part = (int)geom;
+        int global = s->part_tri_offset[part] + (int)prim;
+        if (global >= s->part_tri_offset[part + 1]) continue;
+        /* spatial splits can report one triangle twice */
+        int dup = 0;
+        for (int k = c->n - 1; k >= 0 && k >= c->n - 16; k--)
+            if (c->hits[k].part == part && c->hits[k].triangle == (int)prim) {
+                dup = 1;
+                break;
+            }
+        if (dup) continue;
+        if (c->n == c->cap) {
+            if (c->cap > (1 << 24)) {
+                c->failed = 1;
+                continue;
+            }
+            int cap = 2 * c->cap;
+            sem_ray_hit *h = malloc((size_t)cap * sizeof *h);
+            if (!h) {
+                c->failed = 1;
+                continue;
+            }
+            memcpy(h, c->hits, (size_t)c->n * sizeof *h);
+            if (c->hits != c->local) free(c->hits);
+            c->hits = h;
+            c->cap = cap;
+        }
+        make_hit(s, c->origin, c->dir, part, global, (int)prim, (double)tf, c->use_sign,
+                 c->use_sign, &c->hits[c->n++]);
+    }
+}
+
+static int compare_hits(const void *pa, const void *pb)
+{
+    const sem_ray_hit *a = pa, *b = pb;
+    if (a->t < b->t) return -1;
+    if (a->t > b->t) return 1;
+    if (a->part != b->part) return a->part < b->part ? -1 : 1;
+    if (a->triangle != b->triangle) return a->triangle < b->triangle ? -1 : 1;
+    return 0;
+}
+
+/* Facing of a hit: -1 entering (dir . n < 0), +1 leaving, 0 grazing. */
+static int facing(const double *dir, const sem_ray_hit *h)
+{
+    double dn = dot3(dir, h->normal);
+    return dn < 0 ? -1 : (dn > 0 ? 1 : 0);
+}
+
+/* Clusters hits within merge_eps into crossings (see the file comment): per part of a
+ * cluster, the net facing decides one entering hit, one leaving hit or none; entering
+ * hits come first and all take the cluster's first t. hits sorted by t on entry;
+ * compacted in place; returns the new count. */
+static int merge_hits(const sem_raycast_scene *s, const double *dir, sem_ray_hit *hits, int n)
+{
+    int out = 0;
+    int i = 0;
+    while (i < n) {
+        int j = i + 1;
+        while (j < n && hits[j].t - hits[i].t <= s->merge_eps) j++;
+        if (j == i + 1) {
+            if (facing(dir, &hits[i]) != 0) hits[out++] = hits[i];
+            i = j;
+            continue;
+        }
+        /* copy the cluster aside: the compacted output may overlap it */
+        int len = j - i;
+        sem_ray_hit tmp_local[16];
+        sem_ray_hit *tmp = len <= 16 ? tmp_local : malloc((size_t)len * sizeof *tmp);
+        if (!tmp) { /* keep the cluster unmerged rather than fail */
+            for (int k = i; k < j; k++) hits[out++] = hits[k];
+            i = j;
+            continue;
+        }
+        memcpy(tmp, hits + i, (size_t)len * sizeof *tmp);
+        double t0 = tmp[0].t;
+        for (int pass = 0; pass < 2; pass++) {
+            int want = pass == 0 ? -1 : 1;
+            for (int k = 0; k < len; k++) {
+                int part = tmp[k].part, first = 1;
+                for (int m = 0; m < k; m++)
+                    if (tmp[m].part == part) {
+                        first = 0;
+                        break;
+                    }
+                if (!first) continue;
+                int net = 0;
+                for (int m = k; m < len; m++)
+                    if (tmp[m].part == part) net += facing(dir, &tmp[m]);
+                if (net == 0 || (net < 0 ? -1 : 1) != want) continue;
+                for (int m = k; m < len; m++)
+                    if (tmp[m].part == part && facing(dir, &tmp[m]) == want) {
+                        hits[out] = tmp[m];
+                        hits[out].t = t0;
+                        out++;
+                        break;
+                    }
+            }
+        }
+        if (tmp != tmp_local) free(tmp);
+        i = j;
+    }
+    return out;
+}
+
+/* All hits in (t_near, t_far), merged and sorted. Returns the count (writes at most
+ * max_hits), or -1 when out of memory. */
+static int all_hits(const sem_raycast_scene *s, const double *origin, const double *dir,
+                    double t_near, double t_far, sem_ray_hit *out, int max_hits, int use_sign)
+{
+    hit_collector c;
+    rtcInitIntersectContext(&c.context);
+    c.context.filter = collect_filter;
+    c.scene = s;
+    memcpy(c.origin, origin, sizeof c.origin);
+    memcpy(c.dir, dir, sizeof c.dir);
+    c.use_sign = use_sign;
+    c.hits = c.local;
+    c.n = 0;
+    c.cap = LOCAL_HITS;
+    c.failed = 0;
+
+    struct RTCRayHit rh;
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = (float)origin[0];
+    rh.ray.org_y = (float)origin[1];
+    rh.ray.org_z = (float)origin[2];
+    rh.ray.dir_x = (float)dir[0];
+    rh.ray.dir_y = (float)dir[1];
+    rh.ray.dir_z = (float)dir[2];
+    rh.ray.tnear = t_near > 0 ? (float)t_near : 0.0f;
+    rh.ray.tfar = t_far < 3e38 ? (float)t_far : INFINITY;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (rh.ray.tfar > rh.ray.tnear) rtcIntersect1(s->scene, &c.context, &rh);
+
+    int n = -1;
+    if (!c.failed) {
+        /* keep hits whose double t is in the requested range */
+        int m = 0;
+        for (int k = 0; k < c.n; k++)
+            if (c.hits[k].t > t_near && c.hits[k].t < t_far) c.hits[m++] = c.hits[k];
+        qsort(c.hits, (size_t)m, sizeof *c.hits, compare_hits);
+        n = merge_hits(s, dir, c.hits, m);
+        int copy = n < max_hits ? n : max_hits;
+        if (copy > 0 && out) memcpy(out, c.hits, (size_t)copy * sizeof *out);
+    }
+    if (c.hits != c.local) free(c.hits);
+    return n;
+}
+
+int sem_raycast_all(const sem_raycast_scene *scene, const double origin[3], const double dir[3],
+                    double t_near, double t_far, sem_ray_hit *hits, int max_hits)
+{
+    if (!scene || !origin || !dir || scene->n_triangles == 0) return 0;
+    int n = all_hits(scene, origin, dir, t_near, t_far, hits, max_hits, 1);
+    return n < 0 ? 0 : n;
+}
+
+int sem_raycast_first(const sem_raycast_scene *scene, const double origin[3], const double dir[3],
+                      double t_near, double t_far, sem_ray_hit *hit)
+{
+    if (!scene || !origin || !dir || scene->n_triangles == 0) return 0;
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    struct RTCRayHit rh;
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = (float)origin[0];
+    rh.ray.org_y = (float)origin[1];
+    rh.ray.org_z = (float)origin[2];
+    rh.ray.dir_x = (float)dir[0];
+    rh.ray.dir_y = (float)dir[1];
+    rh.ray.dir_z = (float)dir[2];
+    rh.ray.tnear = t_near > 0 ? (float)t_near : 0.0f;
+    rh.ray.tfar = t_far < 3e38 ? (float)t_far : INFINITY;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (!(rh.ray.tfar > rh.ray.tnear)) return 0;
+    rtcIntersect1(scene->scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.geomID >= (unsigned)scene->n_parts)
+        return 0;
+    int part = (int)rh.hit.geomID;
+    int global = scene->part_tri_offset[part] + (int)rh.hit.primID;
+    if (global >= scene->part_tri_offset[part + 1]) return 0;
+    sem_ray_hit h;
+    make_hit(scene, origin, dir, part, global, (int)rh.hit.primID, (double)rh.ray.tfar, 1, 0,
+             &h);
+    if (hit) *hit = h;
+    return 1;
+}
+
+/* ---- closest parts ---- */
+
+/* Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5). */
+static void closest_point_triangle(const double *p, const double *a, const double *b,
+                                   const double *c, double *q)
+{
+    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    sub3(b, a, ab);
+    sub3(c, a, ac);
+    sub3(p, a, ap);
+    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0 && d2 <= 0) {
+        memcpy(q, a, 3 * sizeof *q);
+        return;
+    }
+    sub3(p, b, bp);
+    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0 && d4 <= d3) {
+        memcpy(q, b, 3 * sizeof *q);
+        return;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double v = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++) q[k] = a[k] + v * ab[k];
+        return;
+    }
+    sub3(p, c, cp);
+    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0 && d5 <= d6) {
+        memcpy(q, c, 3 * sizeof *q);
+        return;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double w = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++) q[k] = a[k] + w * ac[k];
+        return;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++) q[k] = b[k] + w * (c[k] - b[k]);
+        return;
+    }
+    double denom = 1.0 / (va + vb + vc);
+    double v = vb * denom, w = vc * denom;
+    for (int k = 0; k < 3; k++) q[k] = a[k] + ab[k] * v + ac[k] * w;
+}
+
+typedef struct closest_context {
+    const sem_raycast_scene *scene;
+    double X[3];
+    double radius;
+    int *slot;      /* n_parts: index into the found list or -1 */
+    int n_found;
+    int *parts;
+    double *dist;
+    double *points;
+} closest_context;
+
+static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
+{
+    closest_context *c = (closest_context *)args->userPtr;
+    const sem_raycast_scene *s = c->scene;
+    if (args->geomID >= (unsigned)s->n_parts) return false;
+    int part = (int)args->geomID;
+    int global = s->part_tri_offset[part] + (int)args->primID;
+    if (global >= s->part_tri_offset[part + 1]) return false;
+    const double *v = s->tri + 9 * (size_t)global;
+    double q[3], w[3];
+    closest_point_triangle(c->X, v, v + 3, v + 6, q);
+    sub3(q, c->X, w);
+    double dist = sqrt(dot3(w, w));
+    if (dist > c->radius) return false;
+    int k = c->slot[part];
+    if (k < 0) {
+        k = c->n_found++;
+        c->slot[part] = k;
+        c->parts[k] = part;
+        c->dist[k] = INFINITY;
+    }
+    if (dist < c->dist[k]) {
+        c->dist[k] = dist;
+        if (c->points) memcpy(c->points + 3 * k, q, sizeof q);
+    }
+    return false; /* never shrink the radius: every part within it is wanted */
+}
+
+int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3], double radius,
+                              int *out_parts, double *out_dist, double *out_points)
+{
+    if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
+        return 0;
+    int n_parts = scene->n_parts;
+    int slot_local[512];
+    int *slot = n_parts <= 512 ? slot_local : malloc((size_t)n_parts * sizeof *slot);
+    if (!slot) return 0;
+    for (int i = 0; i < n_parts; i++) slot[i] = -1;
+    closest_context c;
+    c.scene = scene;
+    memcpy(c.X, X, sizeof c.X);
+    c.radius = radius;
+    c.slot = slot;
+    c.n_found = 0;
+    c.parts = out_parts;
+    c.dist = out_dist;
+    c.points = out_points;
+
+    struct RTCPointQuery q;
+    q.x = (float)X[0];
+    q.y = (float)X[1];
+    q.z = (float)X[2];
+    q.time = 0.0f;
+    /* float radius padded so float rounding of X and of the boxes never loses a triangle
+     * that is within the exact (double) radius */
+    double r = radius + 1e-6 * scene->scale + 1e-6 * (fabs(X[0]) + fabs(X[1]) + fabs(X[2]));
+    q.radius = r < 3e38 ? (float)r : INFINITY;
+    struct RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(scene->scene, &q, &context, closest_callback, &c);
+
+    /* deterministic output: sorted by part index (insertion sort: small counts) */
+    for (int i = 1; i < c.n_found; i++) {
+        int p = out_parts[i];
+        double dd = out_dist[i], pt[3] = {0, 0, 0};
+        if (out_points) memcpy(pt, out_points + 3 * i, sizeof pt);
+        int j = i - 1;
+        while (j >= 0 && out_parts[j] > p) {
+            out_parts[j + 1] = out_parts[j];
+            out_dist[j + 1] = out_dist[j];
+            if (out_points) memcpy(out_points + 3 * (j + 1), out_points + 3 * j, sizeof pt);
+            j--;
+        }
+        out_parts[j + 1] = p;
+        out_dist[j + 1] = dd;
+        if (out_points) memcpy(out_points + 3 * (j + 1), pt, sizeof pt);
+    }
+    if (slot != slot_local) free(slot);
+    return c.n_found;
+}
+
+/* ---- generalized winding number ---- */
+
+double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
+{
+    if (!scene || !X) return 0.0;
+    double total = 0.0;
+    for (int part = 0; part < scene->n_parts; part++) {
+        double sum = 0.0;
+        for (int t = scene->part_tri_offset[part]; t < scene->part_tri_offset[part + 1]; t++) {
+            const double *v = scene->tri + 9 * (size_t)t;
+            double a[3], b[3], c[3], bc[3];
+            sub3(v, X, a);
+            sub3(v + 3, X, b);
+            sub3(v + 6, X, c);
+            double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), lc = sqrt(dot3(c, c));
+            cross3(b, c, bc);
+            double det = dot3(a, bc);
+            double den = la * lb * lc + dot3(a, b) * lc + dot3(b, c) * la + dot3(c, a) * lb;
+            sum += 2.0 * atan2(det, den); /* signed solid angle (Van Oosterom-Strackee) */
+        }
+        total += scene->part_sign[part] * sum;
+    }
+    return total / (4.0 * M_PI);
+}
+
+/* ---- orientation fix ---- */
+
+#define SIGN_SAMPLES 9
+#define SIGN_RAYS 5
+#define COMPONENT_SAMPLES 48
+
+/* Crossings along a ray: all of them and those of parts in component `self`. Returns 0
+ * when out of memory. */
+static int count_crossings(const sem_raycast_scene *s, const int *component, int self,
+                           const double *origin, const double *dir, double t_near,
+                           int *n_self, int *n_all)
+{
+    sem_ray_hit local[128];
+    sem_ray_hit *hits = local;
+    int n = all_hits(s, origin, dir, t_near, INFINITY, hits, 128, 0);
+    if (n > 128) {
+        hits = malloc((size_t)n * sizeof *hits);
+        if (!hits) return 0;
+        int m = all_hits(s, origin, dir, t_near, INFINITY, hits, n, 0);
+        if (m < n) n = m;
+    }
+    if (n < 0) return 0;
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (component[hits[i].part] == self) k++;
+    *n_self = k;
+    *n_all = n;
+    if (hits != local) free(hits);
+    return 1;
+}
+
+/* Estimates part_sign[part] by ray parity votes (see the file comment). */
+static int estimate_part_sign(const sem_raycast_scene *s, const int *component, int part)
+{
+    int t0 = s->part_tri_offset[part], t1 = s->part_tri_offset[part + 1];
+    int n = t1 - t0;
+    if (n == 0) return 1;
+    int samples = n < SIGN_SAMPLES ? n : SIGN_SAMPLES;
+    double vote = 0.0;
+    double offset = 1e-6 * s->scale;
+    for (int k = 0; k < samples; k++) {
+        /* largest triangle of slice k */
+        int a = t0 + (int)((long long)n * k / samples);
+        int b = t0 + (int)((long long)n * (k + 1) / samples);
+        int best = a;
+        for (int t = a; t < b; t++)
+            if (s->tri_area[t] > s->tri_area[best]) best = t;
+        const double *v = s->tri + 9 * (size_t)best;
+        const double *nrm = s->tri_normal + 3 * (size_t)best;
+        double centre[3];
+        for (int d = 0; d < 3; d++) centre[d] = (v[d] + v[3 + d] + v[6 + d]) / 3.0;
+        /* tangent frame */
+        double e1[3], e2[3];
+        sub3(v + 3, v, e1);
+        double l1 = sqrt(dot3(e1, e1));
+        for (int d = 0; d < 3; d++) e1[d] /= l1;
+        cross3(nrm, e1, e2);
+        for (int r = 0; r < SIGN_RAYS; r++) {
+            double dir[3], back[3];
+            if (r == 0) {
+                memcpy(dir, nrm, sizeof dir);
+            } else {
+                /* 25 degrees off the normal, rotated by 90 degrees plus an odd offset so
+                 * the rays avoid the tessellation's grid directions */
+                double phi = (r - 1) * 0.5 * M_PI + 0.3;
+                double ct = cos(25.0 * M_PI / 180.0), st = sin(25.0 * M_PI / 180.0);
+                for (int d = 0; d < 3; d++)
+                    dir[d] = ct * nrm[d] + st * (cos(phi) * e1[d] + sin(phi) * e2[d]);
+                double l = sqrt(dot3(dir, dir));
+                for (int d = 0; d < 3; d++) dir[d] /= l;
+            }
+            for (int d = 0; d < 3; d++) back[d] = -dir[d];
+            int front_self, front_all, back_self, back_all;
+            if (!count_crossings(s, component, component[part], centre, dir, offset,
+                                 &front_self, &front_all) ||
+                !count_crossings(s, component, component[part], centre, back, offset,
+                                 &back_self, &back_all))
+                continue;
+            /* decisive pair: one side odd, the other even; the own component first */
+            if ((front_self ^ back_self) & 1)
+                vote += (front_self % 2 == 0 ? 1.0 : -1.0) * s->tri_area[best];
+            else if ((front_all ^ back_all) & 1)
+                vote += (front_all % 2 == 0 ? 1.0 : -1.0) * s->tri_area[best];
+        }
+    }
+    return vote >= 0 ? 1 : -1;
+}
+
+static int find_root(int *parent, int i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+static int compare_u64(const void *pa, const void *pb)
+{
+    unsigned long long a = *(const unsigned long long *)pa, b = *(const unsigned long long *)pb;
+    return a < b ? -1 : (a > b ? 1 : 0);
+}
+
+/* Boundary vertices of each part (vertices of edges used by one triangle only), up to
+ * COMPONENT_SAMPLES per part spread along the list: 3 doubles each into samples
+ * (n_parts * COMPONENT_SAMPLES * 3), counts into n_samples. Returns 0 when out of memory. */
+static int boundary_samples(const raw_mesh *mesh, int n_parts, double *samples, int *n_samples)
+{
+    for (int p = 0; p < n_parts; p++) n_samples[p] = 0;
+    size_t n_edges = 3 * (size_t)mesh->n_triangles;
+    unsigned long long *edges = malloc((n_edges > 0 ? n_edges : 1) * sizeof *edges);
+    int *edge_part = malloc((n_edges > 0 ? n_edges : 1) * sizeof *edge_part);
+    if (!edges || !edge_part) {
+        free(edges);
+        free(edge_part);
+        return 0;
+    }
+    /* vertices belong to one part in the shared tessellation, so the key is enough */
+    for (int t = 0; t < mesh->n_triangles; t++)
+        for (int c = 0; c < 3; c++) {
+            unsigned a = (unsigned)mesh->triangles[3 * (size_t)t + c];
+            unsigned b = (unsigned)mesh->triangles[3 * (size_t)t + (c + 1) % 3];
+            unsigned lo = a < b ? a : b, hi = a < b ? b : a;
+            edges[3 * (size_t)t + c] = ((unsigned long long)lo << 32) | hi;
+        }
+    qsort(edges, n_edges, sizeof *edges, compare_u64);
+    /* boundary edges, then their first vertex; vertex -> part via a triangle of the part */
+    int *vertex_part = malloc(((size_t)mesh->n_vertices + 1) * sizeof *vertex_part);
+    if (!vertex_part) {
+        free(edges);
+        free(edge_part);
+        return 0;
+    }
+    for (int v = 0; v < mesh->n_vertices; v++) vertex_part[v] = -1;
+    for (int t = 0; t < mesh->n_triangles; t++)
+        for (int c = 0; c < 3; c++) {
+            int v = mesh->triangles[3 * (size_t)t + c];
+            if (v >= 0 && v < mesh->n_vertices) vertex_part[v] = mesh->triangle_part[t];
+        }
+    size_t n_boundary = 0;
+    for (size_t i = 0; i < n_edges;) {
+        size_t j = i + 1;
+        while (j < n_edges && edges[j] == edges[i]) j++;
+        if (j == i + 1) edges[n_boundary++] = edges[i];
+        i = j;
+    }
+    /* count per part, then take evenly spread ones */
+    int *count = calloc((size_t)n_parts, sizeof *count);
+    int *seen = calloc((size_t)n_parts, sizeof *seen);
+    if (!count || !seen) {
+        free(count);
+        free(seen);
+        free(vertex_part);
+        free(edges);
+        free(edge_part);
+        return 0;
+    }
+    for (size_t e = 0; e < n_boundary; e++) {
+        int v = (int)(edges[e] >> 32);
+        if (v < 0 || v >= mesh->n_vertices) continue;
+        int p = vertex_part[v];
+        if (p >= 0 && p < n_parts) count[p]++;
+    }
+    for (size_t e = 0; e < n_boundary; e++) {
+        int v = (int)(edges[e] >> 32);
+        if (v < 0 || v >= mesh->n_vertices) continue;
+        int p = vertex_part[v];
+        if (p < 0 || p >= n_parts) continue;
+        int idx = seen[p]++;
+        int stride = count[p] / COMPONENT_SAMPLES + 1;
+        if (idx % stride != 0 || n_samples[p] >= COMPONENT_SAMPLES) continue;
+        memcpy(samples + 3 * ((size_t)p * COMPONENT_SAMPLES + (size_t)n_samples[p]),
+               mesh->vertices + 3 * (size_t)v, 3 * sizeof(double));
+        n_samples[p]++;
+    }
+    free(count);
+    free(seen);
+    free(vertex_part);
+    free(edges);
+    free(edge_part);
+    return 1;
+}
+
+/* Components of parts that touch: a boundary sample of one part within tol of another
+ * part joins them (a box's 6 patches form one component; a nested or embedded solid whose
+ * boundary does not touch the outer one is its own component). */
+static int part_components(const sem_raycast_scene *s, const double *samples,
+                           const int *n_samples, int *component)
+{
+    int n_parts = s->n_parts;
+    int *parent = malloc((size_t)n_parts * sizeof *parent);
+    int *found = malloc((size_t)n_parts * sizeof *found);
+    double *dist = malloc((size_t)n_parts * sizeof *dist);
+    if (!parent || !found || !dist) {
+        free(parent);
+        free(found);
+        free(dist);
+        return 0;
+    }
+    for (int p = 0; p < n_parts; p++) parent[p] = p;
+    double tol = 5e-3 * s->scale; /* above the tessellation's chord error along shared edges */
+    for (int p = 0; p < n_parts; p++)
+        for (int k = 0; k < n_samples[p]; k++) {
+            const double *X = samples + 3 * ((size_t)p * COMPONENT_SAMPLES + (size_t)k);
+            int n = sem_raycast_closest_parts(s, X, tol, found, dist, NULL);
+            for (int i = 0; i < n; i++) {
+                int a = find_root(parent, p), b = find_root(parent, found[i]);
+                if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+            }
+        }
+    for (int p = 0; p < n_parts; p++) component[p] = find_root(parent, p);
+    free(parent);
+    free(found);
+    free(dist);
+    return 1;
+}
+
+/* ---- build ---- */
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    (void)user;
+    (void)code;
+    (void)str; /* reported through rtcGetDeviceError where it matters */
+}
+
+sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
+                                   sem_raycast_scene **out, sem_error *err)
+{
+    if (!out) return sem_error_set(err, SEM_ERR_INVALID, "raycast: NULL output");
+    *out = NULL;
+    if (!model || model->n_parts <= 0)
+        return sem_error_set(err, SEM_ERR_INVALID, "raycast: model has no parts");
+    if (resolution < 1)
+        return sem_error_set(err, SEM_ERR_INVALID, "raycast: tessellation resolution %d < 1",
+                             resolution);
+
+    raw_mesh mesh_data, *mesh = &mesh_data;
+    sem_status st = tessellate(model, resolution, mesh, err);
+    if (st != SEM_OK) return st;
+
+    sem_raycast_scene *s = calloc(1, sizeof *s);
+    if (!s) {
+        raw_mesh_free(mesh);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
+    int n_parts = model->n_parts;
+    s->n_parts = n_parts;
+    s->part_sign = malloc((size_t)n_parts * sizeof *s->part_sign);
+    s->part_tri_offset = calloc((size_t)n_parts + 1, sizeof *s->part_tri_offset);
+    size_t cap = mesh->n_triangles > 0 ? (size_t)mesh->n_triangles : 1;
+    s->tri = malloc(cap * 9 * sizeof *s->tri);
+    s->tri_normal = malloc(cap * 3 * sizeof *s->tri_normal);
+    s->tri_area = malloc(cap * sizeof *s->tri_area);
+    s->tri_uv = malloc(cap * 6 * sizeof *s->tri_uv);
+    s->surfaces = calloc((size_t)n_parts, sizeof *s->surfaces);
+    int *order = malloc(cap * sizeof *order);
+    int copied = 1;
+    if (s->surfaces)
+        for (int p = 0; p < n_parts && copied; p++)
+            if (sem_surface_copy(&s->surfaces[p], &model->parts[p].surface) != SEM_OK) {
+                memset(&s->surfaces[p], 0, sizeof s->surfaces[p]);
+                copied = 0;
+            }
+    if (!s->part_sign || !s->part_tri_offset || !s->tri || !s->tri_normal || !s->tri_area ||
+        !s->tri_uv || !s->surfaces || !copied || !order) {
+        free(order);
+        raw_mesh_free(mesh);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
+    for (int i = 0; i < n_parts; i++) s->part_sign[i] = 1;
+
+    /* group triangles by part (stable counting sort), drop degenerate ones */
+    for (int t = 0; t < mesh->n_triangles; t++) {
+        int p = mesh->triangle_part[t];
+        if (p >= 0 && p < n_parts) s->part_tri_offset[p + 1]++;
+    }
+    for (int p = 0; p < n_parts; p++) s->part_tri_offset[p + 1] += s->part_tri_offset[p];
+    {
+        int *fill = calloc((size_t)n_parts, sizeof *fill);
+        if (!fill) {
+            free(order);
+            raw_mesh_free(mesh);
+            sem_raycast_scene_destroy(s);
+            return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+        }
+        for (int t = 0; t < mesh->n_triangles; t++) {
+            int p = mesh->triangle_part[t];
+            if (p >= 0 && p < n_parts) order[s->part_tri_offset[p] + fill[p]++] = t;
+        }
+        free(fill);
+    }
+    int total = s->part_tri_offset[n_parts];
+    int *new_offset = calloc((size_t)n_parts + 1, sizeof *new_offset);
+    if (!new_offset) {
+        free(order);
+        raw_mesh_free(mesh);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
+    int kept = 0;
+    for (int i = 0; i < 3; i++) {
+        s->lo[i] = INFINITY;
+        s->hi[i] = -INFINITY;
+    }
+    for (int p = 0; p < n_parts; p++) {
+        new_offset[p] = kept;
+        for (int k = s->part_tri_offset[p]; k < s->part_tri_offset[p + 1]; k++) {
+            int t = order[k];
+            double *v = s->tri + 9 * (size_t)kept;
+            int ok = 1;
+            for (int c = 0; c < 3; c++) {
+                int vi = mesh->triangles[3 * (size_t)t + c];
+                if (vi < 0 || vi >= mesh->n_vertices) {
+                    ok = 0;
+                    break;
+                }
+                memcpy(v + 3 * c, mesh->vertices + 3 * (size_t)vi, 3 * sizeof *v);
+                memcpy(s->tri_uv + 6 * (size_t)kept + 2 * c, mesh->uv + 2 * (size_t)vi,
+                       2 * sizeof *v);
+                for (int d = 0; d < 3; d++)
+                    if (!isfinite(v[3 * c + d])) ok = 0;
+            }
+            if (!ok) continue;
+            double e1[3], e2[3], n[3];
+            sub3(v + 3, v, e1);
+            sub3(v + 6, v, e2);
+            cross3(e1, e2, n);
+            double len = sqrt(dot3(n, n));
+            if (!(len > 0)) continue;
+            for (int d = 0; d < 3; d++) s->tri_normal[3 * (size_t)kept + d] = n[d] / len;
+            s->tri_area[kept] = 0.5 * len;
+            for (int c = 0; c < 3; c++)
+                for (int d = 0; d < 3; d++) {
+                    if (v[3 * c + d] < s->lo[d]) s->lo[d] = v[3 * c + d];
+                    if (v[3 * c + d] > s->hi[d]) s->hi[d] = v[3 * c + d];
+                }
+            kept++;
+        }
+    }
+    new_offset[n_parts] = kept;
+    (void)total;
+    double *bsamples = malloc((size_t)n_parts * COMPONENT_SAMPLES * 3 * sizeof *bsamples);
+    int *n_bsamples = malloc((size_t)n_parts * sizeof *n_bsamples);
+    if (!bsamples || !n_bsamples || !boundary_samples(mesh, n_parts, bsamples, n_bsamples)) {
+        free(bsamples);
+        free(n_bsamples);
+        free(new_offset);
+        free(order);
+        raw_mesh_free(mesh);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
+    memcpy(s->part_tri_offset, new_offset, ((size_t)n_parts + 1) * sizeof *new_offset);
+    free(new_offset);
+    free(order);
+    raw_mesh_free(mesh);
+    s->n_triangles = kept;
+    if (kept == 0) {
+        free(bsamples);
+        free(n_bsamples);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "raycast: the tessellation of the model has no triangles");
+    }
+    double diag[3];
+    sub3(s->hi, s->lo, diag);
+    s->scale = sqrt(dot3(diag, diag));
+    if (!(s->scale > 0)) s->scale = 1.0;
+    s->merge_eps = 1e-7 * s->scale;
+
+    /* Embree scene */
+    s->device = rtcNewDevice(NULL);
+    if (!s->device) {
+        free(bsamples);
+        free(n_bsamples);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_UNSUPPORTED, "raycast: cannot create Embree device");
+    }
+    rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    s->scene = rtcNewScene(s->device);
+    rtcSetSceneFlags(s->scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(s->scene, RTC_BUILD_QUALITY_HIGH);
+    for (int p = 0; p < n_parts; p++) {
+        int t0 = s->part_tri_offset[p], nt = s->part_tri_offset[p + 1] - t0;
+        if (nt == 0) continue;
+        RTCGeometry g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                            3 * sizeof(float), 3 * (size_t)nt);
+        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(unsigned), (size_t)nt);
+        if (!vb || !ib) {
+            rtcReleaseGeometry(g);
+            free(bsamples);
+            free(n_bsamples);
+            sem_raycast_scene_destroy(s);
+            return sem_error_set(err, SEM_ERR_NOMEM, "raycast: Embree buffer allocation failed");
+        }
+        for (int k = 0; k < 9 * nt; k++) vb[k] = (float)s->tri[9 * (size_t)t0 + k];
+        for (int k = 0; k < 3 * nt; k++) ib[k] = (unsigned)k;
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s->scene, g, (unsigned)p);
+        rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(s->scene);
+    enum RTCError e = rtcGetDeviceError(s->device);
+    if (e != RTC_ERROR_NONE) {
+        free(bsamples);
+        free(n_bsamples);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NUMERIC, "raycast: Embree scene build failed (error %d)",
+                             (int)e);
+    }
+
+    /* orientation fix: votes read only the geometry, each part writes its own entry */
+    int *sign = malloc((size_t)n_parts * sizeof *sign);
+    int *component = malloc((size_t)n_parts * sizeof *component);
+    if (!sign || !component || !part_components(s, bsamples, n_bsamples, component)) {
+        free(sign);
+        free(component);
+        free(bsamples);
+        free(n_bsamples);
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
+    free(bsamples);
+    free(n_bsamples);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int p = 0; p < n_parts; p++) sign[p] = estimate_part_sign(s, component, p);
+    memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
+    free(sign);
+    free(component);
+    *out = s;
+    return SEM_OK;
+}
+
+void sem_raycast_scene_destroy(sem_raycast_scene *scene)
+{
+    if (!scene) return;
+    if (scene->scene) rtcReleaseScene(scene->scene);
+    if (scene->device) rtcReleaseDevice(scene->device);
+    free(scene->part_sign);
+    free(scene->part_tri_offset);
+    free(scene->tri);
+    free(scene->tri_normal);
+    free(scene->tri_area);
+    free(scene->tri_uv);
+    if (scene->surfaces)
+        for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);
+    free(scene->surfaces);
+    free(scene);
+}
+
+void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[3])
+{
+    for (int d = 0; d < 3; d++) {
+        lo[d] = scene ? scene->lo[d] : 0.0;
+        hi[d] = scene ? scene->hi[d] : 0.0;
+    }
+}
+
+int sem_raycast_part_count(const sem_raycast_scene *scene) { return scene ? scene->n_parts : 0; }
+
+int sem_raycast_part_sign(const sem_raycast_scene *scene, int part)
+{
+    if (!scene || part < 0 || part >= scene->n_parts) return 1;
+    return scene->part_sign[part];
+}

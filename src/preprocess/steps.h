@@ -1,0 +1,45 @@
+/*
+ * steps.h - the preprocessing steps as pure functions (internal; composed by preprocess.c).
+ *
+ * Each step reads the model and earlier results and fills its own fields of
+ * sem_discretization; nothing else is shared. Threads: OpenMP over the per-point loops,
+ * with per-thread results merged in a fixed order so results are deterministic for a
+ * fixed thread count.
+ */
+#ifndef SEM_STEPS_H
+#define SEM_STEPS_H
+
+#include "sem/preprocess.h"
+#include "raycast.h"
+
+/* sampling.c: fills n_samples, sample_part, sample_uv, sample_X, sample_area, J_hat,
+ * part_ctrl_offset, n_ctrl, n_parts. Order-of-degree+1 Gauss-Lobatto points per non-empty
+ * knot span in each direction; trimmed parts keep only samples inside their trims. */
+sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_error *err);
+
+/* quadrature.c: fills n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11). */
+sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
+                               const sem_preprocess_options *o, sem_discretization *d,
+                               sem_error *err);
+
+/* weights.c: fills alpha, W, W_samples, weight_nonzero_fraction (Eq. 8-9). */
+sem_status sem_step_weights(const sem_model *model, const sem_raycast_scene *scene,
+                            const sem_preprocess_options *o, sem_discretization *d,
+                            sem_error *err);
+/* theta_i and normalised weights at arbitrary points (used for samples and queries). */
+sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const double *X,
+                             double alpha, double threshold, sem_csr *W, sem_error *err);
+
+/* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
+sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+
+/* projection.c: fills Pi (Eq. 7), hierarchical, robust to ill-conditioned fits. */
+sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretization *d,
+                               sem_error *err);
+
+/* operators.c: fills Gamma, Grad, Gamma_samples, M, M_eps, gamma, length_scale,
+ * stiffness_nnz_percent (Eq. 12-16). */
+sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretization *d,
+                              sem_error *err);
+
+#endif

@@ -1,0 +1,900 @@
+/*
+ * scene.c - scene files (see sem/scene.h and docs/scenes.md).
+ *
+ * Every JSON object is checked against the keys it may have, so a typo ("desnity") is an
+ * error that names the key instead of a silently ignored setting. Messages have the form
+ * "FILE: objects[0].material.density: must be positive (got -3)".
+ */
+#include "sem/scene.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sem/primitives.h"
+
+typedef struct ctx {
+    const char *name;
+    sem_error *err;
+} ctx;
+
+static sem_status fail(ctx *c, const char *where, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static sem_status fail(ctx *c, const char *where, const char *fmt, ...)
+{
+    char msg[700];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return sem_error_set(c->err, SEM_ERR_INVALID, "%s: %s: %s", c->name, where, msg);
+}
+
+/* Rejects keys that are not in the NULL-terminated list. */
+static sem_status check_keys(ctx *c, const cJSON *obj, const char *where, const char *const *allowed)
+{
+    if (!cJSON_IsObject(obj)) return fail(c, where, "must be a JSON object");
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        int ok = 0;
+        for (int k = 0; allowed[k]; ++k)
+            if (strcmp(it->string, allowed[k]) == 0) ok = 1;
+        if (!ok) {
+            char list[512] = "";
+            for (int k = 0; allowed[k]; ++k) {
+                strncat(list, allowed[k], sizeof list - strlen(list) - 1);
+                if (allowed[k + 1]) strncat(list, ", ", sizeof list - strlen(list) - 1);
+            }
+            return fail(c, where, "unknown key \"%s\" (allowed: %s)", it->string, list);
+        }
+    }
+    return SEM_OK;
+}
+
+static sem_status get_number(ctx *c, const cJSON *obj, const char *key, const char *where,
+                             double *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) return SEM_OK;
+    char w[256];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble)) return fail(c, w, "must be a finite number");
+    *out = v->valuedouble;
+    return SEM_OK;
+}
+
+static sem_status get_int(ctx *c, const cJSON *obj, const char *key, const char *where, int *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) return SEM_OK;
+    char w[256];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble) || fabs(v->valuedouble) > 1e9)
+        return fail(c, w, "must be an integer");
+    *out = (int)v->valuedouble;
+    return SEM_OK;
+}
+
+static sem_status get_bool(ctx *c, const cJSON *obj, const char *key, const char *where, int *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) return SEM_OK;
+    char w[256];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    if (!cJSON_IsBool(v)) return fail(c, w, "must be true or false");
+    *out = cJSON_IsTrue(v);
+    return SEM_OK;
+}
+
+static sem_status vec_n(ctx *c, const cJSON *v, const char *where, int n, double *out)
+{
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n)
+        return fail(c, where, "must be an array of %d numbers", n);
+    int k = 0;
+    for (const cJSON *it = v->child; it; it = it->next, ++k) {
+        if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
+            return fail(c, where, "element %d is not a finite number", k);
+        out[k] = it->valuedouble;
+    }
+    return SEM_OK;
+}
+
+static sem_status get_vec(ctx *c, const cJSON *obj, const char *key, const char *where, int n,
+                          double *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v) return SEM_OK;
+    char w[256];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return vec_n(c, v, w, n, out);
+}
+
+static sem_status get_box(ctx *c, const cJSON *v, const char *where, double box[6])
+{
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2)
+        return fail(c, where, "must be [[x0,y0,z0],[x1,y1,z1]]");
+    char w[256];
+    snprintf(w, sizeof w, "%s[0]", where);
+    sem_status st = vec_n(c, cJSON_GetArrayItem(v, 0), w, 3, box);
+    if (st != SEM_OK) return st;
+    snprintf(w, sizeof w, "%s[1]", where);
+    st = vec_n(c, cJSON_GetArrayItem(v, 1), w, 3, box + 3);
+    if (st != SEM_OK) return st;
+    for (int k = 0; k < 3; ++k)
+        if (box[k] > box[k + 3]) return fail(c, where, "lower corner exceeds upper corner along axis %d", k);
+    return SEM_OK;
+}
+
+static sem_status parse_material(ctx *c, const cJSON *m, const char *where, sem_material *out)
+{
+    static const char *const keys[] = {"type", "density", "youngs_modulus", "poisson_ratio", NULL};
+    sem_status st = check_keys(c, m, where, keys);
+    if (st != SEM_OK) return st;
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(m, "type");
+    if (t) {
+        char w[256];
+        snprintf(w, sizeof w, "%s.type", where);
+        if (!cJSON_IsString(t) || sem_material_parse_type(t->valuestring, &out->type) != SEM_OK)
+            return fail(c, w,
+                        "unknown material type (use neohookean, stable_neohookean, corotated, "
+                        "stvk or linear)");
+    }
+    if ((st = get_number(c, m, "density", where, &out->density)) != SEM_OK) return st;
+    if ((st = get_number(c, m, "youngs_modulus", where, &out->youngs_modulus)) != SEM_OK) return st;
+    if ((st = get_number(c, m, "poisson_ratio", where, &out->poisson_ratio)) != SEM_OK) return st;
+    sem_error e;
+    sem_material tmp = *out;
+    if (sem_material_init(&tmp, &e) != SEM_OK) return fail(c, where, "%s", e.message);
+    *out = tmp;
+    return SEM_OK;
+}
+
+static void mat_identity(double T[12])
+{
+    memset(T, 0, 12 * sizeof(double));
+    T[0] = T[5] = T[10] = 1.0;
+}
+
+/* T = A * T (both 3x4 affine) */
+static void mat_compose(double T[12], const double A[12])
+{
+    double R[12];
+    for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 4; ++col) {
+            double s = col == 3 ? A[4 * r + 3] : 0.0;
+            for (int k = 0; k < 3; ++k) s += A[4 * r + k] * T[4 * k + col];
+            R[4 * r + col] = s;
+        }
+    }
+    memcpy(T, R, sizeof R);
+}
+
+static sem_status parse_transform(ctx *c, const cJSON *t, const char *where, double T[12])
+{
+    static const char *const keys[] = {"scale", "rotate", "translate", "matrix", NULL};
+    sem_status st = check_keys(c, t, where, keys);
+    if (st != SEM_OK) return st;
+    mat_identity(T);
+    char w[256];
+    /* order: scale, then rotate, then translate (or a full matrix) */
+    const cJSON *m = cJSON_GetObjectItemCaseSensitive(t, "matrix");
+    if (m) {
+        snprintf(w, sizeof w, "%s.matrix", where);
+        if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 3) return fail(c, w, "must be 3 rows of 4 numbers");
+        for (int r = 0; r < 3; ++r) {
+            char wr[300];
+            snprintf(wr, sizeof wr, "%s[%d]", w, r);
+            if ((st = vec_n(c, cJSON_GetArrayItem(m, r), wr, 4, T + 4 * r)) != SEM_OK) return st;
+        }
+        return SEM_OK;
+    }
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(t, "scale");
+    if (s) {
+        double sc[3];
+        snprintf(w, sizeof w, "%s.scale", where);
+        if (cJSON_IsNumber(s))
+            sc[0] = sc[1] = sc[2] = s->valuedouble;
+        else if ((st = vec_n(c, s, w, 3, sc)) != SEM_OK)
+            return st;
+        for (int k = 0; k < 3; ++k)
+            if (!(sc[k] > 0) || !isfinite(sc[k])) return fail(c, w, "scale factors must be positive");
+        double A[12] = {sc[0], 0, 0, 0, 0, sc[1], 0, 0, 0, 0, sc[2], 0};
+        mat_compose(T, A);
+    }
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(t, "rotate");
+    if (r) {
+        static const char *const rkeys[] = {"axis", "degrees", NULL};
+        snprintf(w, sizeof w, "%s.rotate", where);
+        if ((st = check_keys(c, r, w, rkeys)) != SEM_OK) return st;
+        double axis[3] = {0, 0, 1}, deg = 0;
+        if ((st = get_vec(c, r, "axis", w, 3, axis)) != SEM_OK) return st;
+        if ((st = get_number(c, r, "degrees", w, &deg)) != SEM_OK) return st;
+        double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+        if (!(n > 0)) return fail(c, w, "axis must not be zero");
+        double x = axis[0] / n, y = axis[1] / n, z = axis[2] / n, a = deg * M_PI / 180.0;
+        double cs = cos(a), sn = sin(a), C = 1 - cs;
+        double A[12] = {cs + x * x * C,     x * y * C - z * sn, x * z * C + y * sn, 0,
+                        y * x * C + z * sn, cs + y * y * C,     y * z * C - x * sn, 0,
+                        z * x * C - y * sn, z * y * C + x * sn, cs + z * z * C,     0};
+        mat_compose(T, A);
+    }
+    const cJSON *tr = cJSON_GetObjectItemCaseSensitive(t, "translate");
+    if (tr) {
+        double b[3];
+        snprintf(w, sizeof w, "%s.translate", where);
+        if ((st = vec_n(c, tr, w, 3, b)) != SEM_OK) return st;
+        T[3] += b[0];
+        T[7] += b[1];
+        T[11] += b[2];
+    }
+    return SEM_OK;
+}
+
+static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_preprocess_options *o)
+{
+    static const char *const keys[] = {"order", "alpha", "sparsity", "rays", "ray_axis",
+                                       "points_per_interval", "gamma", "tessellation",
+                                       "weight_threshold", NULL};
+    sem_status st = check_keys(c, s, where, keys);
+    if (st != SEM_OK) return st;
+    char w[256];
+    if ((st = get_int(c, s, "order", where, &o->order)) != SEM_OK) return st;
+    if (o->order != 1 && o->order != 2) {
+        snprintf(w, sizeof w, "%s.order", where);
+        return fail(c, w, "must be 1 or 2 (got %d)", o->order);
+    }
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(s, "alpha");
+    if (a && !cJSON_IsNull(a)) {
+        if ((st = get_number(c, s, "alpha", where, &o->alpha)) != SEM_OK) return st;
+        if (!(o->alpha > 0)) {
+            snprintf(w, sizeof w, "%s.alpha", where);
+            return fail(c, w, "must be positive (got %g)", o->alpha);
+        }
+    }
+    const cJSON *sp = cJSON_GetObjectItemCaseSensitive(s, "sparsity");
+    if (sp && !cJSON_IsNull(sp)) {
+        if ((st = get_number(c, s, "sparsity", where, &o->sparsity)) != SEM_OK) return st;
+        if (!(o->sparsity > 0 && o->sparsity < 1)) {
+            snprintf(w, sizeof w, "%s.sparsity", where);
+            return fail(c, w, "must be in (0, 1) (got %g)", o->sparsity);
+        }
+    }
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(s, "rays");
+    if (r) {
+        double rr[2];
+        snprintf(w, sizeof w, "%s.rays", where);
+        if ((st = vec_n(c, r, w, 2, rr)) != SEM_OK) return st;
+        if (rr[0] < 1 || rr[1] < 1 || rr[0] > 10000 || rr[1] > 10000 || rr[0] != floor(rr[0]) ||
+            rr[1] != floor(rr[1]))
+            return fail(c, w, "must be two integers in 1..10000");
+        o->rays[0] = (int)rr[0];
+        o->rays[1] = (int)rr[1];
+    }
+    const cJSON *ax = cJSON_GetObjectItemCaseSensitive(s, "ray_axis");
+    if (ax) {
+        snprintf(w, sizeof w, "%s.ray_axis", where);
+        if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || !strchr("xyz", ax->valuestring[0]))
+            return fail(c, w, "must be \"x\", \"y\" or \"z\"");
+        o->ray_axis = ax->valuestring[0] - 'x';
+    }
+    if ((st = get_int(c, s, "points_per_interval", where, &o->points_per_interval)) != SEM_OK) return st;
+    if (o->points_per_interval < 1) {
+        snprintf(w, sizeof w, "%s.points_per_interval", where);
+        return fail(c, w, "must be at least 1");
+    }
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(s, "gamma");
+    if (g && !cJSON_IsNull(g)) {
+        if ((st = get_number(c, s, "gamma", where, &o->gamma)) != SEM_OK) return st;
+        if (!(o->gamma > 0)) {
+            snprintf(w, sizeof w, "%s.gamma", where);
+            return fail(c, w, "must be positive or null (got %g)", o->gamma);
+        }
+    }
+    if ((st = get_int(c, s, "tessellation", where, &o->tessellation)) != SEM_OK) return st;
+    if (o->tessellation < 1 || o->tessellation > 256) {
+        snprintf(w, sizeof w, "%s.tessellation", where);
+        return fail(c, w, "must be in 1..256");
+    }
+    if ((st = get_number(c, s, "weight_threshold", where, &o->weight_threshold)) != SEM_OK) return st;
+    if (!(o->weight_threshold >= 0 && o->weight_threshold < 0.5)) {
+        snprintf(w, sizeof w, "%s.weight_threshold", where);
+        return fail(c, w, "must be in [0, 0.5)");
+    }
+    return SEM_OK;
+}
+
+static sem_status parse_int_list(ctx *c, const cJSON *v, const char *where, int **out, int *n)
+{
+    if (!cJSON_IsArray(v)) return fail(c, where, "must be an array of integers");
+    int cnt = cJSON_GetArraySize(v);
+    int *a = malloc(((size_t)cnt + 1) * sizeof(int));
+    if (!a) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+    int k = 0;
+    for (const cJSON *it = v->child; it; it = it->next, ++k) {
+        if (!cJSON_IsNumber(it) || it->valuedouble != floor(it->valuedouble) || it->valuedouble < 0 ||
+            it->valuedouble > 1e9) {
+            free(a);
+            return fail(c, where, "element %d is not a non-negative integer", k);
+        }
+        a[k] = (int)it->valuedouble;
+    }
+    *out = a;
+    *n = cnt;
+    return SEM_OK;
+}
+
+static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *base_dir,
+                               sem_scene_object *obj)
+{
+    static const char *const keys[] = {"model", "primitive", "transform", "material",
+                                       "part_materials", "sem", "pin", "prescribe",
+                                       "initial_velocity", "initial_angular_velocity",
+                                       "point_loads", "region_loads", "gamma", NULL};
+    char where[64], w[256];
+    snprintf(where, sizeof where, "objects[%d]", index);
+    sem_status st = check_keys(c, o, where, keys);
+    if (st != SEM_OK) return st;
+    mat_identity(obj->transform);
+    obj->material = sem_default_material();
+    obj->sem = sem_default_preprocess_options();
+    const cJSON *model = cJSON_GetObjectItemCaseSensitive(o, "model");
+    const cJSON *prim = cJSON_GetObjectItemCaseSensitive(o, "primitive");
+    if (!!model == !!prim) return fail(c, where, "needs exactly one of \"model\" or \"primitive\"");
+    if (model) {
+        snprintf(w, sizeof w, "%s.model", where);
+        if (!cJSON_IsString(model) || !model->valuestring[0]) return fail(c, w, "must be a file path");
+        const char *p = model->valuestring;
+        if (p[0] == '/' || !base_dir || !base_dir[0])
+            snprintf(obj->model_path, sizeof obj->model_path, "%s", p);
+        else
+            snprintf(obj->model_path, sizeof obj->model_path, "%s/%s", base_dir, p);
+    } else {
+        static const char *const pkeys[] = {"type", "size", "length", "width", "height", "sections",
+                                            "radius", "major", "minor", NULL};
+        snprintf(w, sizeof w, "%s.primitive", where);
+        if ((st = check_keys(c, prim, w, pkeys)) != SEM_OK) return st;
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(prim, "type");
+        if (!cJSON_IsString(t) || (strcmp(t->valuestring, "box") && strcmp(t->valuestring, "beam") &&
+                                   strcmp(t->valuestring, "sphere") && strcmp(t->valuestring, "cylinder") &&
+                                   strcmp(t->valuestring, "torus")))
+            return fail(c, w, "type must be box, beam, sphere, cylinder or torus");
+        snprintf(obj->primitive, sizeof obj->primitive, "%s", t->valuestring);
+        obj->primitive_size[0] = obj->primitive_size[1] = obj->primitive_size[2] = 0;
+        obj->primitive_sections = 0;
+        if ((st = get_vec(c, prim, "size", w, 3, obj->primitive_size)) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "length", w, &obj->primitive_size[0])) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "width", w, &obj->primitive_size[1])) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "height", w, &obj->primitive_height)) != SEM_OK) return st;
+        obj->primitive_size[2] = obj->primitive_height;
+        if ((st = get_int(c, prim, "sections", w, &obj->primitive_sections)) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "radius", w, &obj->primitive_radius)) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "major", w, &obj->primitive_radius)) != SEM_OK) return st;
+        if ((st = get_number(c, prim, "minor", w, &obj->primitive_radius2)) != SEM_OK) return st;
+    }
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
+    if (t) {
+        snprintf(w, sizeof w, "%s.transform", where);
+        if ((st = parse_transform(c, t, w, obj->transform)) != SEM_OK) return st;
+    }
+    const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "material");
+    if (m) {
+        snprintf(w, sizeof w, "%s.material", where);
+        if ((st = parse_material(c, m, w, &obj->material)) != SEM_OK) return st;
+    } else {
+        sem_error e;
+        sem_material_init(&obj->material, &e);
+    }
+    const cJSON *pm = cJSON_GetObjectItemCaseSensitive(o, "part_materials");
+    if (pm) {
+        snprintf(w, sizeof w, "%s.part_materials", where);
+        if (!cJSON_IsObject(pm)) return fail(c, w, "must map part indices or names to materials");
+        int n = cJSON_GetArraySize(pm);
+        obj->part_materials = calloc((size_t)n + 1, sizeof *obj->part_materials);
+        if (!obj->part_materials) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+        for (const cJSON *it = pm->child; it; it = it->next) {
+            sem_scene_part_material *spm = &obj->part_materials[obj->n_part_materials++];
+            char *end;
+            long idx = strtol(it->string, &end, 10);
+            if (*it->string && !*end && idx >= 0) {
+                spm->part = (int)idx;
+            } else {
+                spm->part = -1;
+                snprintf(spm->name, sizeof spm->name, "%s", it->string);
+            }
+            spm->material = obj->material;
+            char w2[300];
+            snprintf(w2, sizeof w2, "%s.%s", w, it->string);
+            if ((st = parse_material(c, it, w2, &spm->material)) != SEM_OK) return st;
+        }
+    }
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(o, "sem");
+    obj->sem.youngs_modulus = obj->material.youngs_modulus;
+    if (s) {
+        snprintf(w, sizeof w, "%s.sem", where);
+        if ((st = parse_sem(c, s, w, &obj->sem)) != SEM_OK) return st;
+    }
+    const cJSON *pin = cJSON_GetObjectItemCaseSensitive(o, "pin");
+    if (pin) {
+        static const char *const pkeys[] = {"box", "parts", "points", NULL};
+        snprintf(w, sizeof w, "%s.pin", where);
+        if ((st = check_keys(c, pin, w, pkeys)) != SEM_OK) return st;
+        const cJSON *b = cJSON_GetObjectItemCaseSensitive(pin, "box");
+        char w2[300];
+        if (b) {
+            snprintf(w2, sizeof w2, "%s.box", w);
+            if ((st = get_box(c, b, w2, obj->pin_box)) != SEM_OK) return st;
+            obj->has_pin_box = 1;
+        }
+        const cJSON *pp = cJSON_GetObjectItemCaseSensitive(pin, "parts");
+        if (pp) {
+            snprintf(w2, sizeof w2, "%s.parts", w);
+            if ((st = parse_int_list(c, pp, w2, &obj->pin_parts, &obj->n_pin_parts)) != SEM_OK) return st;
+        }
+        const cJSON *pt = cJSON_GetObjectItemCaseSensitive(pin, "points");
+        if (pt) {
+            snprintf(w2, sizeof w2, "%s.points", w);
+            if ((st = parse_int_list(c, pt, w2, &obj->pin_points, &obj->n_pin_points)) != SEM_OK) return st;
+        }
+    }
+    const cJSON *pr = cJSON_GetObjectItemCaseSensitive(o, "prescribe");
+    if (pr) {
+        static const char *const pkeys[] = {"affine", "rotate", NULL};
+        snprintf(w, sizeof w, "%s.prescribe", where);
+        if ((st = check_keys(c, pr, w, pkeys)) != SEM_OK) return st;
+        const cJSON *af = cJSON_GetObjectItemCaseSensitive(pr, "affine");
+        const cJSON *ro = cJSON_GetObjectItemCaseSensitive(pr, "rotate");
+        if (af && ro) return fail(c, w, "give either \"affine\" or \"rotate\", not both");
+        char w2[300];
+        if (af) {
+            snprintf(w2, sizeof w2, "%s.affine", w);
+            if (!cJSON_IsArray(af) || cJSON_GetArraySize(af) != 3) return fail(c, w2, "must be 3 rows of 4 numbers");
+            for (int r = 0; r < 3; ++r) {
+                char wr[320];
+                snprintf(wr, sizeof wr, "%s[%d]", w2, r);
+                if ((st = vec_n(c, cJSON_GetArrayItem(af, r), wr, 4, obj->prescribe.affine + 4 * r)) != SEM_OK)
+                    return st;
+            }
+            obj->prescribe.type = SEM_PRESCRIBE_AFFINE;
+        }
+        if (ro) {
+            static const char *const rkeys[] = {"axis_point", "axis", "degrees_per_second",
+                                                "radians_per_second", "duration", NULL};
+            snprintf(w2, sizeof w2, "%s.rotate", w);
+            if ((st = check_keys(c, ro, w2, rkeys)) != SEM_OK) return st;
+            obj->prescribe.type = SEM_PRESCRIBE_ROTATE;
+            obj->prescribe.axis_direction[0] = 1;
+            if ((st = get_vec(c, ro, "axis_point", w2, 3, obj->prescribe.axis_point)) != SEM_OK) return st;
+            if ((st = get_vec(c, ro, "axis", w2, 3, obj->prescribe.axis_direction)) != SEM_OK) return st;
+            double dps = 0, rps = 0;
+            if ((st = get_number(c, ro, "degrees_per_second", w2, &dps)) != SEM_OK) return st;
+            if ((st = get_number(c, ro, "radians_per_second", w2, &rps)) != SEM_OK) return st;
+            obj->prescribe.rate = rps != 0 ? rps : dps * M_PI / 180.0;
+            if ((st = get_number(c, ro, "duration", w2, &obj->prescribe.duration)) != SEM_OK) return st;
+            const double *a = obj->prescribe.axis_direction;
+            if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] > 0)) return fail(c, w2, "axis must not be zero");
+        }
+    }
+    if ((st = get_vec(c, o, "initial_velocity", where, 3, obj->initial_velocity)) != SEM_OK) return st;
+    if ((st = get_vec(c, o, "initial_angular_velocity", where, 3, obj->initial_angular_velocity)) != SEM_OK)
+        return st;
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(o, "gamma");
+    if (g && !cJSON_IsNull(g)) {
+        if ((st = get_number(c, o, "gamma", where, &obj->sem.gamma)) != SEM_OK) return st;
+        if (!(obj->sem.gamma > 0)) {
+            snprintf(w, sizeof w, "%s.gamma", where);
+            return fail(c, w, "must be positive");
+        }
+    }
+    const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "point_loads");
+    if (pl) {
+        snprintf(w, sizeof w, "%s.point_loads", where);
+        if (!cJSON_IsArray(pl)) return fail(c, w, "must be an array");
+        int n = cJSON_GetArraySize(pl);
+        obj->point_loads = calloc((size_t)n + 1, sizeof *obj->point_loads);
+        if (!obj->point_loads) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+        int k = 0;
+        for (const cJSON *it = pl->child; it; it = it->next, ++k) {
+            static const char *const lkeys[] = {"position", "force", NULL};
+            char w2[300];
+            snprintf(w2, sizeof w2, "%s[%d]", w, k);
+            if ((st = check_keys(c, it, w2, lkeys)) != SEM_OK) return st;
+            if (!cJSON_GetObjectItemCaseSensitive(it, "position") || !cJSON_GetObjectItemCaseSensitive(it, "force"))
+                return fail(c, w2, "needs \"position\" and \"force\"");
+            if ((st = get_vec(c, it, "position", w2, 3, obj->point_loads[k].X)) != SEM_OK) return st;
+            if ((st = get_vec(c, it, "force", w2, 3, obj->point_loads[k].force)) != SEM_OK) return st;
+            obj->n_point_loads = k + 1;
+        }
+    }
+    const cJSON *rl = cJSON_GetObjectItemCaseSensitive(o, "region_loads");
+    if (rl) {
+        snprintf(w, sizeof w, "%s.region_loads", where);
+        if (!cJSON_IsArray(rl)) return fail(c, w, "must be an array");
+        int n = cJSON_GetArraySize(rl);
+        obj->region_loads = calloc((size_t)n + 1, sizeof *obj->region_loads);
+        if (!obj->region_loads) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+        int k = 0;
+        for (const cJSON *it = rl->child; it; it = it->next, ++k) {
+            static const char *const lkeys[] = {"box", "force_density", "frequency", "phase", NULL};
+            char w2[300], w3[320];
+            snprintf(w2, sizeof w2, "%s[%d]", w, k);
+            if ((st = check_keys(c, it, w2, lkeys)) != SEM_OK) return st;
+            const cJSON *b = cJSON_GetObjectItemCaseSensitive(it, "box");
+            if (!b || !cJSON_GetObjectItemCaseSensitive(it, "force_density"))
+                return fail(c, w2, "needs \"box\" and \"force_density\"");
+            snprintf(w3, sizeof w3, "%s.box", w2);
+            if ((st = get_box(c, b, w3, obj->region_loads[k].box)) != SEM_OK) return st;
+            if ((st = get_vec(c, it, "force_density", w2, 3, obj->region_loads[k].force_density)) != SEM_OK)
+                return st;
+            if ((st = get_number(c, it, "frequency", w2, &obj->region_loads[k].frequency)) != SEM_OK) return st;
+            if ((st = get_number(c, it, "phase", w2, &obj->region_loads[k].phase)) != SEM_OK) return st;
+            if (obj->region_loads[k].frequency < 0) return fail(c, w2, "frequency must be >= 0");
+            obj->n_region_loads = k + 1;
+        }
+    }
+    return SEM_OK;
+}
+
+static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
+{
+    sem_status st;
+    if ((st = get_vec(c, root, "gravity", "scene", 3, s->world.gravity)) != SEM_OK) return st;
+    const cJSON *in = cJSON_GetObjectItemCaseSensitive(root, "integrator");
+    if (in) {
+        static const char *const keys[] = {"type", "dt", "damping", "tolerance", "max_iterations",
+                                           "solver", NULL};
+        const char *w = "integrator";
+        if ((st = check_keys(c, in, w, keys)) != SEM_OK) return st;
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(in, "type");
+        if (t) {
+            if (!cJSON_IsString(t)) return fail(c, "integrator.type", "must be a string");
+            if (!strcmp(t->valuestring, "linearly_implicit_euler"))
+                s->world.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+            else if (!strcmp(t->valuestring, "implicit_euler"))
+                s->world.integrator = SEM_IMPLICIT_EULER;
+            else if (!strcmp(t->valuestring, "static"))
+                s->world.integrator = SEM_STATIC;
+            else
+                return fail(c, "integrator.type",
+                            "unknown integrator \"%s\" (use linearly_implicit_euler, implicit_euler "
+                            "or static)",
+                            t->valuestring);
+        }
+        if ((st = get_number(c, in, "dt", w, &s->world.dt)) != SEM_OK) return st;
+        if (!(s->world.dt > 0)) return fail(c, "integrator.dt", "must be positive (got %g)", s->world.dt);
+        const cJSON *d = cJSON_GetObjectItemCaseSensitive(in, "damping");
+        if (d) {
+            static const char *const dkeys[] = {"mass", "stiffness", NULL};
+            if ((st = check_keys(c, d, "integrator.damping", dkeys)) != SEM_OK) return st;
+            if ((st = get_number(c, d, "mass", "integrator.damping", &s->world.rayleigh_mass)) != SEM_OK) return st;
+            if ((st = get_number(c, d, "stiffness", "integrator.damping", &s->world.rayleigh_stiffness)) != SEM_OK)
+                return st;
+            if (s->world.rayleigh_mass < 0 || s->world.rayleigh_stiffness < 0)
+                return fail(c, "integrator.damping", "coefficients must be >= 0");
+        }
+        if ((st = get_number(c, in, "tolerance", w, &s->world.newton_tolerance)) != SEM_OK) return st;
+        if (!(s->world.newton_tolerance > 0)) return fail(c, "integrator.tolerance", "must be positive");
+        if ((st = get_int(c, in, "max_iterations", w, &s->world.newton_max_iterations)) != SEM_OK) return st;
+        if (s->world.newton_max_iterations < 1) return fail(c, "integrator.max_iterations", "must be >= 1");
+        const cJSON *so = cJSON_GetObjectItemCaseSensitive(in, "solver");
+        if (so) {
+            if (!cJSON_IsString(so)) return fail(c, "integrator.solver", "must be a string");
+            if (!strcmp(so->valuestring, "auto")) s->world.solver = SEM_SOLVER_AUTO;
+            else if (!strcmp(so->valuestring, "sparse")) s->world.solver = SEM_SOLVER_SPARSE;
+            else if (!strcmp(so->valuestring, "dense")) s->world.solver = SEM_SOLVER_DENSE;
+            else return fail(c, "integrator.solver", "must be auto, sparse or dense");
+        }
+    }
+    if ((st = get_int(c, root, "frames", "scene", &s->frames)) != SEM_OK) return st;
+    if (s->frames < 0) return fail(c, "frames", "must be >= 0");
+    if ((st = get_int(c, root, "steps_per_frame", "scene", &s->steps_per_frame)) != SEM_OK) return st;
+    if (s->steps_per_frame < 1) return fail(c, "steps_per_frame", "must be >= 1");
+    if ((st = get_int(c, root, "threads", "scene", &s->world.threads)) != SEM_OK) return st;
+    const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
+    if (out) {
+        static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "mesh_resolution", NULL};
+        if ((st = check_keys(c, out, "output", keys)) != SEM_OK) return st;
+        const cJSON *d = cJSON_GetObjectItemCaseSensitive(out, "dir");
+        if (d) {
+            if (!cJSON_IsString(d) || !d->valuestring[0]) return fail(c, "output.dir", "must be a folder path");
+            snprintf(s->output_dir, sizeof s->output_dir, "%s", d->valuestring);
+        }
+        if ((st = get_bool(c, out, "iges", "output", &s->write_iges)) != SEM_OK) return st;
+        if ((st = get_bool(c, out, "obj", "output", &s->write_obj)) != SEM_OK) return st;
+        if ((st = get_bool(c, out, "mesh", "output", &s->write_mesh)) != SEM_OK) return st;
+        if ((st = get_bool(c, out, "usd", "output", &s->write_usd)) != SEM_OK) return st;
+        if ((st = get_int(c, out, "mesh_resolution", "output", &s->mesh_resolution)) != SEM_OK) return st;
+        if (s->mesh_resolution < 1 || s->mesh_resolution > 64) return fail(c, "output.mesh_resolution", "must be in 1..64");
+    }
+    return SEM_OK;
+}
+
+static void object_free(sem_scene_object *o)
+{
+    free(o->part_materials);
+    free(o->pin_parts);
+    free(o->pin_points);
+    free(o->point_loads);
+    free(o->region_loads);
+}
+
+void sem_scene_destroy(sem_scene *s)
+{
+    if (!s) return;
+    for (int i = 0; i < s->n_objects; ++i) object_free(&s->objects[i]);
+    free(s->objects);
+    free(s);
+}
+
+sem_status sem_scene_parse(const char *json, const char *name, const char *base_dir,
+                           sem_scene **out, sem_error *err)
+{
+    *out = NULL;
+    ctx c = {name, err};
+    cJSON *root = cJSON_Parse(json);
+    if (!root) {
+        const char *e = cJSON_GetErrorPtr();
+        int line = 1;
+        if (e)
+            for (const char *p = json; p < e && *p; ++p) line += *p == '\n';
+        return sem_error_set(err, SEM_ERR_PARSE, "%s:%d: not valid JSON", name, line);
+    }
+    sem_scene *s = calloc(1, sizeof *s);
+    if (!s) {
+        cJSON_Delete(root);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    s->world = sem_default_world_def();
+    s->frames = 120;
+    s->steps_per_frame = 1;
+    snprintf(s->output_dir, sizeof s->output_dir, "out");
+    s->write_iges = 1;
+    s->write_obj = 0;
+    s->write_mesh = 1;
+    s->write_usd = 1;
+    s->mesh_resolution = 6;
+    static const char *const keys[] = {"objects", "gravity", "integrator", "frames",
+                                       "steps_per_frame", "output", "threads", "description", NULL};
+    sem_status st = check_keys(&c, root, "scene", keys);
+    if (st == SEM_OK) st = parse_world(&c, root, s);
+    const cJSON *objs = cJSON_GetObjectItemCaseSensitive(root, "objects");
+    if (st == SEM_OK && (!cJSON_IsArray(objs) || cJSON_GetArraySize(objs) == 0))
+        st = fail(&c, "objects", "must be a non-empty array of objects");
+    if (st == SEM_OK) {
+        int n = cJSON_GetArraySize(objs);
+        s->objects = calloc((size_t)n, sizeof *s->objects);
+        if (!s->objects) st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        int k = 0;
+        for (const cJSON *it = objs->child; st == SEM_OK && it; it = it->next, ++k) {
+            s->n_objects = k + 1;
+            st = parse_object(&c, it, k, base_dir, &s->objects[k]);
+        }
+    }
+    cJSON_Delete(root);
+    if (st != SEM_OK) {
+        sem_scene_destroy(s);
+        return st;
+    }
+    *out = s;
+    return SEM_OK;
+}
+
+sem_status sem_scene_load(const char *path, sem_scene **out, sem_error *err)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    if (len < 0 || len > (64L << 20)) {
+        fclose(f);
+        return sem_error_set(err, SEM_ERR_IO, "%s: cannot read (or larger than 64 MiB)", path);
+    }
+    char *buf = malloc((size_t)len + 1);
+    if (!buf) {
+        fclose(f);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    size_t got = fread(buf, 1, (size_t)len, f);
+    fclose(f);
+    buf[got] = '\0';
+    char base[4096];
+    snprintf(base, sizeof base, "%s", path);
+    char *slash = strrchr(base, '/');
+    if (slash)
+        *slash = '\0';
+    else
+        strcpy(base, ".");
+    sem_status st = sem_scene_parse(buf, path, base, out, err);
+    free(buf);
+    if (st == SEM_OK) snprintf((*out)->path, sizeof (*out)->path, "%s", path);
+    return st;
+}
+
+const char *sem_scene_default_json(void)
+{
+    /* A soft rubber beam (2 m x 0.4 m x 0.4 m, 4 sections) clamped at x = 0, released
+     * straight and swinging down under gravity. */
+    return "{\n"
+           "  \"description\": \"rubber beam clamped at x = 0 swinging under gravity\",\n"
+           "  \"objects\": [{\n"
+           "    \"primitive\": {\"type\": \"beam\", \"sections\": 4, \"length\": 2.0, \"width\": 0.4, \"height\": 0.4},\n"
+           "    \"material\": {\"type\": \"neohookean\", \"density\": 1100, \"youngs_modulus\": 3e5, \"poisson_ratio\": 0.45},\n"
+           "    \"sem\": {\"order\": 2, \"rays\": [4, 4], \"points_per_interval\": 12},\n"
+           "    \"pin\": {\"box\": [[-0.01, -1, -1], [0.01, 1, 1]]}\n"
+           "  }],\n"
+           "  \"gravity\": [0, 0, -9.81],\n"
+           "  \"integrator\": {\"type\": \"implicit_euler\", \"dt\": 0.01},\n"
+           "  \"frames\": 100,\n"
+           "  \"steps_per_frame\": 2,\n"
+           "  \"output\": {\"dir\": \"out\"}\n"
+           "}\n";
+}
+
+static void apply_transform(sem_model *m, const double T[12])
+{
+    int identity = 1;
+    static const double I[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    for (int k = 0; k < 12; ++k) identity &= T[k] == I[k];
+    if (identity) return;
+    for (int i = 0; i < m->n_parts; ++i) {
+        sem_surface *s = &m->parts[i].surface;
+        for (int c = 0; c < s->n_u * s->n_v; ++c) {
+            double *x = s->ctrl + 3 * c, y[3];
+            for (int r = 0; r < 3; ++r) y[r] = T[4 * r] * x[0] + T[4 * r + 1] * x[1] + T[4 * r + 2] * x[2] + T[4 * r + 3];
+            memcpy(x, y, sizeof y);
+        }
+    }
+}
+
+sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model **out, sem_error *err)
+{
+    const sem_scene_object *o = &scene->objects[index];
+    *out = NULL;
+    sem_status st;
+    sem_model *m = NULL;
+    if (o->model_path[0]) {
+        st = sem_model_load(o->model_path, &m, err);
+        if (st != SEM_OK) {
+            if (err && !strstr(err->message, o->model_path)) {
+                char msg[sizeof err->message];
+                snprintf(msg, sizeof msg, "%s", err->message);
+                sem_error_set(err, st, "%s: objects[%d].model: %s", scene->path[0] ? scene->path : "scene",
+                              index, msg);
+            }
+            return st;
+        }
+    } else {
+        m = sem_model_create();
+        if (!m) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        const char *t = o->primitive;
+        if (!strcmp(t, "box")) {
+            sem_box_def d = sem_default_box_def();
+            for (int k = 0; k < 3; ++k)
+                if (o->primitive_size[k] > 0) d.size[k] = o->primitive_size[k];
+            st = sem_primitive_box(m, &d, err);
+        } else if (!strcmp(t, "beam")) {
+            sem_beam_def d = sem_default_beam_def();
+            if (o->primitive_sections > 0) d.sections = o->primitive_sections;
+            if (o->primitive_size[0] > 0) d.length = o->primitive_size[0];
+            if (o->primitive_size[1] > 0) d.width = o->primitive_size[1];
+            if (o->primitive_size[2] > 0) d.height = o->primitive_size[2];
+            st = sem_primitive_beam(m, &d, err);
+        } else if (!strcmp(t, "sphere")) {
+            sem_sphere_def d = sem_default_sphere_def();
+            if (o->primitive_radius > 0) d.radius = o->primitive_radius;
+            st = sem_primitive_sphere(m, &d, err);
+        } else if (!strcmp(t, "cylinder")) {
+            sem_cylinder_def d = sem_default_cylinder_def();
+            if (o->primitive_radius > 0) d.radius = o->primitive_radius;
+            if (o->primitive_height > 0) d.height = o->primitive_height;
+            st = sem_primitive_cylinder(m, &d, err);
+        } else {
+            sem_torus_def d = sem_default_torus_def();
+            if (o->primitive_radius > 0) d.major = o->primitive_radius;
+            if (o->primitive_radius2 > 0) d.minor = o->primitive_radius2;
+            st = sem_primitive_torus(m, &d, err);
+        }
+        if (st != SEM_OK) {
+            sem_model_destroy(m);
+            return st;
+        }
+    }
+    apply_transform(m, o->transform);
+    *out = m;
+    return SEM_OK;
+}
+
+sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, unsigned char **out,
+                                 sem_error *err)
+{
+    size_t n = sem_model_control_points(m);
+    *out = NULL;
+    if (!o->has_pin_box && o->n_pin_parts == 0 && o->n_pin_points == 0) return SEM_OK;
+    unsigned char *pin = calloc(n + 1, 1);
+    if (!pin) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    size_t *off = malloc(((size_t)m->n_parts + 1) * sizeof(size_t));
+    if (!off) {
+        free(pin);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    sem_model_part_offsets(m, off);
+    for (int i = 0; i < m->n_parts; ++i) {
+        const sem_surface *s = &m->parts[i].surface;
+        int whole = 0;
+        for (int k = 0; k < o->n_pin_parts; ++k) whole |= o->pin_parts[k] == i;
+        for (int c = 0; c < s->n_u * s->n_v; ++c) {
+            const double *x = s->ctrl + 3 * c;
+            int in = o->has_pin_box && x[0] >= o->pin_box[0] && x[1] >= o->pin_box[1] && x[2] >= o->pin_box[2] &&
+                     x[0] <= o->pin_box[3] && x[1] <= o->pin_box[4] && x[2] <= o->pin_box[5];
+            if (in || whole) pin[off[i] + (size_t)c] = 1;
+        }
+    }
+    for (int k = 0; k < o->n_pin_parts; ++k)
+        if (o->pin_parts[k] >= m->n_parts) {
+            free(off);
+            free(pin);
+            return sem_error_set(err, SEM_ERR_INVALID, "pin.parts: part %d does not exist (model has %d parts)",
+                                 o->pin_parts[k], m->n_parts);
+        }
+    for (int k = 0; k < o->n_pin_points; ++k) {
+        if ((size_t)o->pin_points[k] >= n) {
+            free(off);
+            free(pin);
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "pin.points: control point %d does not exist (model has %zu)", o->pin_points[k], n);
+        }
+        pin[o->pin_points[k]] = 1;
+    }
+    free(off);
+    size_t count = 0;
+    for (size_t c = 0; c < n; ++c) count += pin[c];
+    if (count == 0) {
+        free(pin);
+        return sem_error_set(err, SEM_ERR_INVALID, "pin: selects no control point of the model");
+    }
+    *out = pin;
+    return SEM_OK;
+}
+
+sem_status sem_scene_object_part_materials(const sem_scene_object *o, const sem_model *m, int **out,
+                                           sem_material **materials, sem_error *err)
+{
+    *out = NULL;
+    *materials = NULL;
+    if (o->n_part_materials == 0) return SEM_OK;
+    int *idx = malloc(((size_t)m->n_parts + 1) * sizeof(int));
+    sem_material *mats = malloc((size_t)o->n_part_materials * sizeof(sem_material));
+    if (!idx || !mats) {
+        free(idx);
+        free(mats);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int i = 0; i < m->n_parts; ++i) idx[i] = -1;
+    for (int k = 0; k < o->n_part_materials; ++k) {
+        const sem_scene_part_material *pm = &o->part_materials[k];
+        mats[k] = pm->material;
+        int found = 0;
+        for (int i = 0; i < m->n_parts; ++i) {
+            if ((pm->part >= 0 && pm->part == i) || (pm->part < 0 && !strcmp(pm->name, m->parts[i].name))) {
+                idx[i] = k;
+                found = 1;
+            }
+        }
+        if (!found) {
+            free(idx);
+            free(mats);
+            if (pm->part >= 0)
+                return sem_error_set(err, SEM_ERR_INVALID, "part_materials: part %d does not exist (model has %d parts)",
+                                     pm->part, m->n_parts);
+            return sem_error_set(err, SEM_ERR_INVALID, "part_materials: no part is named \"%s\"", pm->name);
+        }
+    }
+    *out = idx;
+    *materials = mats;
+    return SEM_OK;
+}

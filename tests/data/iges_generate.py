@@ -1,0 +1,425 @@
+#!/usr/bin/env python3
+"""Writes the small IGES test files tests/data/iges_*.igs used by tests/test_iges_read.c.
+
+Each file is written the way a CAD exporter lays it out (80 columns, section letters in
+column 73, DE/PD pointers), so the files can be read and edited by hand; this script only
+saves counting columns. Run it from anywhere: python3 tests/data/iges_generate.py
+"""
+import math
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def r(x):
+    """Exact decimal text of a float (shortest round trip)."""
+    return repr(float(x))
+
+
+def holl(s):
+    return "%dH%s" % (len(s), s)
+
+
+class Ent:
+    def __init__(self, type_, params, form=0, xform=0, status="00000000", label="",
+                 subscript=0, color=0):
+        self.type = type_
+        self.params = params  # list of str, or callables of the DE map
+        self.form = form
+        self.xform = xform
+        self.status = status
+        self.label = label
+        self.subscript = subscript
+        self.color = color
+
+
+def de(i):
+    """DE number of the entity at index i."""
+    return 2 * i + 1
+
+
+def build(entities, unit_flag=6, unit_name="M", pd=",", rd=";", start="sem test file",
+          eol="\n", short=False):
+    lines = []
+
+    def line(data, sec, seq):
+        text = "%-72s%s%7d" % (data, sec, seq)
+        if short:
+            text = text[:73]  # sequence numbers cut off (some writers do)
+        lines.append(text)
+
+    line(start, "S", 1)
+    g = [holl(pd), holl(rd), holl("sem"), holl("test.igs"), holl("sem generator"),
+         holl("1.0"), "32", "38", "6", "308", "15", holl("sem"), "1.0", str(unit_flag),
+         holl(unit_name), "1", "0.08", holl("20240101.000000"), "1.0E-6", "100.0",
+         holl("sem"), holl("sem"), "11", "0", holl("20240101.000000")]
+    text = pd.join(g) + rd
+    gl = []
+    cur = ""
+    for tok in [t + pd for t in g[:-1]] + [g[-1] + rd]:
+        if len(cur) + len(tok) > 72:
+            gl.append(cur)
+            cur = ""
+        cur += tok
+    gl.append(cur)
+    for i, t in enumerate(gl):
+        line(t, "G", i + 1)
+    # parameter data
+    plines = []
+    starts = []
+    counts = []
+    for i, e in enumerate(entities):
+        toks = [str(e.type)] + [str(p) for p in e.params]
+        starts.append(len(plines) + 1)
+        cur = ""
+        out = []
+        for k, tok in enumerate(toks):
+            tok = tok + (rd if k == len(toks) - 1 else pd)
+            while len(cur) + len(tok) > 64:
+                if cur:
+                    out.append(cur)
+                    cur = ""
+                else:  # a token longer than a line (long Hollerith): split it
+                    out.append(tok[:64])
+                    tok = tok[64:]
+            cur += tok
+        out.append(cur)
+        for o in out:
+            plines.append((o, de(i)))
+        counts.append(len(out))
+    for i, e in enumerate(entities):
+        d1 = "%8d%8d%8d%8d%8d%8d%8d%8d%8s" % (e.type, starts[i], 0, 0, 0, 0, e.xform, 0,
+                                             e.status)
+        d2 = "%8d%8d%8d%8d%8d%8s%8s%8s%8d" % (e.type, 0, e.color, counts[i], e.form, "", "",
+                                             e.label, e.subscript)
+        line(d1, "D", 2 * i + 1)
+        line(d2, "D", 2 * i + 2)
+    for k, (o, back) in enumerate(plines):
+        line("%-64s %7d" % (o, back), "P", k + 1)
+    line("S%7dG%7dD%7dP%7d" % (1, len(gl), 2 * len(entities), len(plines)), "T", 1)
+    return eol.join(lines) + eol
+
+
+def save(name, text):
+    with open(os.path.join(HERE, name), "w", newline="") as f:
+        f.write(text)
+
+
+# ---------------------------------------------------------------- entities ----
+
+def nurbs_curve(degree, knots, ctrl, weights=None, t0=None, t1=None, fmt=r):
+    n = len(ctrl)
+    weights = weights or [1.0] * n
+    t0 = knots[degree] if t0 is None else t0
+    t1 = knots[n] if t1 is None else t1
+    p = [n - 1, degree, 0, 0, 1 if all(w == 1 for w in weights) else 0, 0]
+    p += [fmt(k) for k in knots] + [fmt(w) for w in weights]
+    for c in ctrl:
+        p += [fmt(x) for x in c]
+    p += [fmt(t0), fmt(t1), "0.0", "0.0", "1.0"]
+    return p
+
+
+def nurbs_surface(du, dv, ku, kv, grid, weights=None, fmt=r, rng=None):
+    """grid[j][i] = point (i along u fastest, as IGES stores)."""
+    nu, nv = len(grid[0]), len(grid)
+    weights = weights or [1.0] * (nu * nv)
+    p = [nu - 1, nv - 1, du, dv, 0, 0, 1 if all(w == 1 for w in weights) else 0, 0, 0]
+    p += [fmt(k) for k in ku] + [fmt(k) for k in kv] + [fmt(w) for w in weights]
+    for row in grid:
+        for c in row:
+            p += [fmt(x) for x in c]
+    rng = rng or (ku[du], ku[nu], kv[dv], kv[nv])
+    p += [fmt(x) for x in rng]
+    return p
+
+
+def patch(x0, y0, z0, sx, sy):
+    """Bilinear 2x2 patch of size sx x sy at (x0, y0, z0), domain [0,1]^2."""
+    return nurbs_surface(1, 1, [0, 0, 1, 1], [0, 0, 1, 1],
+                         [[(x0, y0, z0), (x0 + sx, y0, z0)],
+                          [(x0, y0 + sy, z0), (x0 + sx, y0 + sy, z0)]])
+
+
+def biquad():
+    """A 3x3 quadratic patch over [0,2]x[0,1] with distinct weights (exactness checks)."""
+    grid = [[(0, 0, 0), (1, 0, 0.5), (2, 0, 0)],
+            [(0, 1, 0.25), (1, 1, 1.0), (2, 1, 0.25)],
+            [(0, 2, 0), (1, 2, 0.5), (2, 2, 0)]]
+    w = [1, 0.5, 1, 0.75, 1.25, 0.75, 1, 0.5, 1]
+    return nurbs_surface(2, 2, [0, 0, 0, 2, 2, 2], [0, 0, 0, 1, 1, 1], grid, w)
+
+
+def line(p, q):
+    return [r(x) for x in p] + [r(x) for x in q]
+
+
+def uv_square(a, b, c, d):
+    """Four 110 lines around [a,b]x[c,d] in parameter space (z = 0)."""
+    pts = [(a, c, 0), (b, c, 0), (b, d, 0), (a, d, 0)]
+    return [Ent(110, line(pts[k], pts[(k + 1) % 4])) for k in range(4)]
+
+
+def xform(rot, t):
+    p = []
+    for i in range(3):
+        p += [r(rot[i][0]), r(rot[i][1]), r(rot[i][2]), r(t[i])]
+    return p
+
+
+# ------------------------------------------------------------------ files ----
+
+def file_delims():
+    # param delimiter '/', record delimiter '!', CRLF, D exponents, a name with both
+    # delimiters (and the default ones) inside a Hollerith string
+    dfmt = lambda x: ("%.17g" % x).replace("e", "D") if "e" in ("%.17g" % x) else "%sD0" % r(x)
+    grid = [[(0, 0, 0), (2.5e-3, 0, 0)], [(0, 1.5e2, 0), (2.5e-3, 1.5e2, 1.25)]]
+    s = nurbs_surface(1, 1, [0, 0, 1, 1], [0, 0, 1, 1], grid, fmt=dfmt)
+    s += ["0", "1", de(1)]  # no associativities, one property
+    name = "a/b!c,d;e"
+    ents = [Ent(128, s), Ent(406, ["1", holl(name)], form=15)]
+    save("iges_delims.igs", build(ents, unit_flag=2, unit_name="MM", pd="/", rd="!", eol="\r\n"))
+
+
+def file_short_lines():
+    ents = [Ent(128, patch(0, 0, 0, 1, 1), label="PANEL", subscript=7)]
+    save("iges_short_lines.igs", build(ents, unit_flag=1, unit_name="IN", short=True))
+
+
+def file_xform():
+    # entity 0: 128 moved by 124 (DE 3): rotate 90 deg about z, translate (10, 0, 0)
+    # entity 2: 128 with chained 124s: DE 7 (translate (0,0,5)) whose own transform is
+    # DE 9 (scale 2)
+    rz = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    ident = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    ents = [Ent(128, patch(1, 2, 3, 1, 1), xform=de(1)),
+            Ent(124, xform(rz, (10, 0, 0))),
+            Ent(128, patch(1, 2, 3, 1, 1), xform=de(3)),
+            Ent(124, xform(ident, (0, 0, 5)), xform=de(4)),
+            Ent(124, xform([[2, 0, 0], [0, 2, 0], [0, 0, 2]], (0, 0, 0)))]
+    save("iges_xform.igs", build(ents))
+
+
+def file_subfigure():
+    # definition (308, DE 1) of a trimmed patch (144 DE 3 -> 128 DE 5, loop 142 DE 7 ->
+    # composite DE 9 of 4 lines) and a plain patch (128 DE 19); two instances (408).
+    dep = "00010200"
+    sub = "00010000"
+    ents = [None] * 12
+    ents[0] = Ent(308, ["0", holl("BLOCK"), "2", de(1), de(9)], status=dep)
+    ents[1] = Ent(144, [de(2), "1", "0", de(3)], status=sub)
+    ents[2] = Ent(128, patch(0, 0, 0, 1, 1), status=sub)
+    ents[3] = Ent(142, ["1", de(2), de(4), "0", "1"], status=sub)
+    ents[4] = Ent(102, ["4", de(5), de(6), de(7), de(8)], status=sub)
+    sq = uv_square(0.25, 0.75, 0.25, 0.75)
+    for k in range(4):
+        sq[k].status = sub
+        ents[5 + k] = sq[k]
+    ents[9] = Ent(128, patch(0, 0, 1, 1, 1), status=sub)
+    rz = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    ents[10] = Ent(408, [de(0), "10.0", "0.0", "0.0", "2.0"])
+    ents[11] = Ent(408, [de(0), "0.0", "0.0", "0.0", ""], xform=de(12))
+    ents.append(Ent(124, xform(rz, (0, 0, 0))))
+    save("iges_subfigure.igs", build(ents))
+
+
+def file_plane():
+    # bounded plane z = 2 (0 x + 0 y + 1 z = 2), bounded by a full circle of radius 1 around
+    # (3, 4); and an unbounded plane x = 1 with display point (1, 5, 6) and SIZE 0.5
+    ents = [Ent(108, ["0.0", "0.0", "1.0", "2.0", de(1), "3.0", "4.0", "2.0", "1.0"], form=1),
+            Ent(100, ["2.0", "3.0", "4.0", "4.0", "4.0", "4.0", "4.0"]),
+            Ent(108, ["1.0", "0.0", "0.0", "1.0", "0", "1.0", "5.0", "6.0", "0.5"])]
+    save("iges_plane.igs", build(ents))
+
+
+def file_ruled():
+    # 118 form 1 between the line (0,0,0)-(2,0,0) and a half circle of radius 1 around
+    # (1, 0) at z = 3 from (2, 0) to (0, 0) (counter-clockwise, through (1, 1))
+    ents = [Ent(118, [de(1), de(2), "0", "0"], form=1),
+            Ent(110, line((0, 0, 0), (2, 0, 0))),
+            Ent(100, ["3.0", "1.0", "0.0", "2.0", "0.0", "0.0", "0.0"])]
+    save("iges_ruled.igs", build(ents))
+
+
+def file_revolution():
+    # cylinder: generatrix (2,0,0)-(2,0,3) about the z axis, full turn
+    # sphere: the right half of the unit circle in the xy plane about the y axis
+    ents = [Ent(120, [de(1), de(2), "0.0", r(2 * math.pi)]),
+            Ent(110, line((0, 0, 0), (0, 0, 1))),
+            Ent(110, line((2, 0, 0), (2, 0, 3))),
+            Ent(120, [de(4), de(5), "0.0", r(2 * math.pi)]),
+            Ent(110, line((0, -1, 0), (0, 1, 0))),
+            Ent(100, ["0.0", "0.0", "0.0", "0.0", "-1.0", "0.0", "1.0"])]
+    save("iges_revolution.igs", build(ents))
+
+
+def file_tabulated():
+    # quarter circle of radius 3 around the origin, extruded by (0, 0, 5)
+    ents = [Ent(122, [de(1), "3.0", "0.0", "5.0"]),
+            Ent(100, ["0.0", "0.0", "0.0", "3.0", "0.0", "0.0", "3.0"])]
+    save("iges_tabulated.igs", build(ents))
+
+
+def file_brep():
+    # 186 -> 514 with two faces. Face 1 (510) trims a patch with a square loop whose edges
+    # have parameter-space lines; face 2's loop edges have none (K = 0): kept untrimmed.
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    i186 = add(None)
+    i514 = add(None)
+    i510a = add(None)
+    i510b = add(None)
+    s1 = add(Ent(128, patch(0, 0, 0, 1, 1), status=sub))
+    s2 = add(Ent(128, patch(0, 0, 0, 1, 1), status=sub))
+    # vertex list and model-space edges of the square (0.25..0.75) on face 1 (z = 0)
+    pts = [(0.25, 0.25, 0), (0.75, 0.25, 0), (0.75, 0.75, 0), (0.25, 0.75, 0)]
+    vl = add(Ent(502, ["4"] + [r(x) for p in pts for x in p], form=1, status=sub))
+    curves3 = [add(Ent(110, line(pts[k], pts[(k + 1) % 4]), status=sub)) for k in range(4)]
+    ep = ["4"]
+    for k in range(4):
+        ep += [de(curves3[k]), de(vl), str(k + 1), de(vl), str((k + 1) % 4 + 1)]
+    el = add(Ent(504, ep, form=1, status=sub))
+    pcs = [add(Ent(110, line((p[0], p[1], 0), (q[0], q[1], 0)), status=sub))
+           for p, q in zip(pts, pts[1:] + pts[:1])]
+    lp1 = ["4"]
+    for k in range(4):
+        lp1 += ["0", de(el), str(k + 1), "1", "1", "0", de(pcs[k])]
+    loop1 = add(Ent(508, lp1, form=1, status=sub))
+    lp2 = ["4"]
+    for k in range(4):
+        lp2 += ["0", de(el), str(k + 1), "1", "0"]
+    loop2 = add(Ent(508, lp2, form=1, status=sub))
+    E[i186] = Ent(186, [de(i514), "1", "0"])
+    E[i514] = Ent(514, ["2", de(i510a), "1", de(i510b), "1"], form=1, status=sub)
+    E[i510a] = Ent(510, [de(s1), "1", "1", de(loop1)], form=1, status=sub)
+    E[i510b] = Ent(510, [de(s2), "1", "1", de(loop2)], form=1, status=sub)
+    save("iges_brep.igs", build(E))
+
+
+def file_unknown():
+    ents = [Ent(128, patch(0, 0, 0, 1, 1)),
+            Ent(112, ["3", "1", "3", "1", "0.0", "1.0"] + ["0.0"] * 24),
+            Ent(314, ["100.0", "0.0", "0.0", holl("red")]),
+            Ent(406, ["1", holl("unused")], form=15),
+            Ent(212, ["1", "4", "1.0", "1.0", "0", "0.0", "0", "0", "0.0", "0.0", "0.0",
+                      holl("NOTE")])]
+    save("iges_unknown.igs", build(ents))
+
+
+def file_cad_trimmed():
+    """SolidWorks/CATIA-like 144 + 142 (BPTR and CPTR both given, a composite outer
+    loop and a circular hole) and a 143 + 141 (TYPE 1) with a reversed (SENSE 2) piece."""
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    t144 = add(None)
+    srf = add(Ent(128, biquad(), status="00010000"))
+    # outer loop in (u,v) over [0,2]x[0,1]: composite of 4 lines inset by 0.1
+    pts = [(0.1, 0.1, 0), (1.9, 0.1, 0), (1.9, 0.9, 0), (0.1, 0.9, 0)]
+    ls = [add(Ent(110, line(pts[k], pts[(k + 1) % 4]), status="00010000")) for k in range(4)]
+    comp = add(Ent(102, ["4"] + [de(i) for i in ls], status="00010000"))
+    c3d = add(Ent(126, nurbs_curve(1, [0, 0, 1, 1], [(0.1, 0.1, 0), (1.9, 0.1, 0)]),
+                  status="00010000"))  # model-space curve (not used by the reader)
+    o142 = add(Ent(142, ["0", de(srf), de(comp), de(c3d), "1"], status="00010000"))
+    hole = add(Ent(100, ["0.0", "1.0", "0.5", "1.2", "0.5", "1.2", "0.5"], status="00010000"))
+    h142 = add(Ent(142, ["0", de(srf), de(hole), "0", "1"], status="00010000"))
+    E[t144] = Ent(144, [de(srf), "1", "1", de(o142), de(h142)], color=3)
+    # 143/141: surface = same biquad data, boundary triangle in (u,v) with 2 pieces, the
+    # second given backwards and marked SENSE 2
+    t143 = add(None)
+    srf2 = add(Ent(128, biquad(), status="00010000"))
+    a = add(Ent(126, nurbs_curve(1, [0, 0, 1, 2, 2], [(0.2, 0.2, 0), (1.8, 0.2, 0), (1.0, 0.8, 0)]),
+                status="00010000"))
+    b = add(Ent(126, nurbs_curve(2, [0, 0, 0, 3, 3, 3], [(0.2, 0.2, 0), (0.5, 0.6, 0), (1.0, 0.8, 0)],
+                                 weights=[1.0, 0.5, 1.0]), status="00010000"))
+    m3 = add(Ent(110, line((0, 0, 0), (1, 0, 0)), status="00010000"))
+    b141 = add(Ent(141, ["1", "1", de(srf2), "2", de(m3), "1", "1", de(a),
+                         de(m3), "2", "1", de(b)], status="00010000"))
+    E[t143] = Ent(143, ["1", de(srf2), "1", de(b141)], label="BOUNDED", subscript=2)
+    save("iges_cad_trimmed.igs", build(E))
+
+
+def file_bptr0():
+    ents = [Ent(144, [de(1), "1", "0", de(2)]),
+            Ent(128, patch(0, 0, 0, 1, 1), status="00010000"),
+            Ent(142, ["0", de(1), "0", de(3), "2"], status="00010000"),
+            Ent(110, line((0, 0, 0), (1, 1, 0)), status="00010000")]
+    save("iges_bptr0.igs", build(ents))
+
+
+# ---------------------------------------------------------------- errors ----
+
+def good_curve_surface():
+    """A valid trimmed part used as the base of the error files (128 at DE 3)."""
+    sq = uv_square(0.25, 0.75, 0.25, 0.75)
+    return [Ent(144, [de(1), "1", "0", de(2)]),
+            Ent(128, patch(0, 0, 0, 1, 1), status="00010000"),
+            Ent(142, ["0", de(1), de(3), "0", "1"], status="00010000"),
+            Ent(102, ["4", de(4), de(5), de(6), de(7)], status="00010000")] + sq
+
+
+def errors():
+    base = build(good_curve_surface())
+    save("iges_err_base_ok.igs", base)
+    save("iges_err_empty.igs", "")
+    lines = base.split("\n")
+    pidx = [i for i, l in enumerate(lines) if len(l) > 72 and l[72] == "P"]
+    save("iges_err_truncated.igs", "\n".join(lines[:pidx[len(pidx) // 2]]) + "\n")
+    save("iges_err_no_terminate.igs", "\n".join(l for l in lines if not (len(l) > 72 and l[72] == "T")))
+
+    def variant(name, mutate):
+        ents = good_curve_surface()
+        mutate(ents)
+        save(name, build(ents))
+
+    def set_param(ents, i, k, v):
+        ents[i].params[k - 1] = v
+
+    variant("iges_err_pointer_range.igs", lambda e: set_param(e, 0, 1, "999"))
+    variant("iges_err_pointer_type.igs", lambda e: set_param(e, 0, 1, de(3)))
+    # K = 5 but the data has 2 x 2 points
+    variant("iges_err_counts.igs", lambda e: set_param(e, 1, 1, "5"))
+    variant("iges_err_not_number.igs", lambda e: set_param(e, 1, 20, "1.0x"))
+    variant("iges_err_nan.igs", lambda e: set_param(e, 1, 20, "nan"))
+    variant("iges_err_inf.igs", lambda e: set_param(e, 1, 20, "1.0D999"))
+    variant("iges_err_zero_weight.igs", lambda e: set_param(e, 1, 18, "0.0"))
+    variant("iges_err_negative_weight.igs", lambda e: set_param(e, 1, 18, "-1.0"))
+    # decreasing: u knots 0, 0, 1, 1 -> 0, 1, 0.5, 1 (knot 2 < knot 1)
+    variant("iges_err_knots.igs", lambda e: (set_param(e, 1, 11, "1.0"), set_param(e, 1, 12, "0.5")))
+    # degree 2 in u with 2 control points
+    variant("iges_err_degree.igs", lambda e: set_param(e, 1, 3, "2"))
+    # the third line of the loop ends somewhere else: loop does not close
+    variant("iges_err_open_loop.igs", lambda e: set_param(e, 6, 4, "0.5"))
+    # 124 chain that points to itself
+    def cyc(ents):
+        ents[1].xform = de(len(ents))
+        ents.append(Ent(124, xform([[1, 0, 0], [0, 1, 0], [0, 0, 1]], (0, 0, 0)),
+                        xform=de(len(ents))))
+    variant("iges_err_xform_cycle.igs", cyc)
+    # a Hollerith string claiming more characters than the entity has
+    variant("iges_err_hollerith.igs",
+            lambda e: e.append(Ent(406, ["1", "40Hshort"], form=15)))
+
+
+if __name__ == "__main__":
+    file_delims()
+    file_short_lines()
+    file_xform()
+    file_subfigure()
+    file_plane()
+    file_ruled()
+    file_revolution()
+    file_tabulated()
+    file_brep()
+    file_unknown()
+    file_cad_trimmed()
+    file_bptr0()
+    errors()

@@ -1,0 +1,224 @@
+/* test_simulation.c - elastodynamics against closed forms and conservation laws (issue 4). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "sem/material.h"
+#include "sem/preprocess.h"
+#include "sem/primitives.h"
+#include "sem/simulation.h"
+#include "test_util.h"
+
+typedef struct setup {
+    sem_model *model;
+    sem_discretization *disc;
+    sem_world *world;
+} setup;
+
+static void setup_free(setup *s)
+{
+    sem_world_destroy(s->world);
+    sem_discretization_destroy(s->disc);
+    sem_model_destroy(s->model);
+    memset(s, 0, sizeof *s);
+}
+
+static int make_box_world(setup *s, int order, const sem_world_def *wd, const sem_object_def *od_in)
+{
+    memset(s, 0, sizeof *s);
+    sem_error err;
+    s->model = sem_model_create();
+    sem_box_def bd = sem_default_box_def();
+    bd.size[0] = 2.0;
+    bd.center[2] = 1.0;
+    if (sem_primitive_box(s->model, &bd, &err) != SEM_OK) {
+        CHECK(0, "box: %s", err.message);
+        return 0;
+    }
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.order = order;
+    po.rays[0] = po.rays[1] = 4;
+    po.points_per_interval = 4;
+    if (sem_preprocess(s->model, &po, &s->disc, &err) != SEM_OK) {
+        CHECK(0, "preprocess: %s", err.message);
+        return 0;
+    }
+    s->world = sem_world_create(wd, &err);
+    CHECK(s->world != NULL, "world: %s", err.message);
+    if (!s->world) return 0;
+    sem_object_def od = od_in ? *od_in : sem_default_object_def();
+    od.model = s->model;
+    od.disc = s->disc;
+    int id = sem_world_add_object(s->world, &od, &err);
+    CHECK(id == 0, "add object: %s", err.message);
+    return id == 0;
+}
+
+/* Free fall with the linearly implicit Euler step: z_n = z0 - g h^2 n(n+1)/2 exactly,
+ * because M (1 x g) = f_g and translations carry no elastic or error force. */
+static void test_free_fall(void)
+{
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.81;
+    wd.dt = 0.01;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    setup s;
+    if (!make_box_world(&s, 2, &wd, NULL)) {
+        setup_free(&s);
+        return;
+    }
+    sem_object_stats st0, st;
+    sem_world_object_stats(s.world, 0, &st0);
+    sem_error err;
+    int n = 50;
+    for (int k = 0; k < n; ++k) CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
+    sem_world_object_stats(s.world, 0, &st);
+    double drop = 9.81 * wd.dt * wd.dt * n * (n + 1) / 2.0;
+    CHECK_REL(st0.center_of_mass[2] - st.center_of_mass[2], drop, 1e-9);
+    CHECK_NEAR(st.center_of_mass[0], st0.center_of_mass[0], 1e-9 * drop);
+    CHECK_REL(st.linear_momentum[2], -st.mass * 9.81 * wd.dt * n, 1e-9);
+    CHECK_REL(st0.volume, 2.0, 1e-12);
+    setup_free(&s);
+}
+
+/* Zero gravity: linear momentum is conserved to round-off by the linearly implicit step
+ * (1^T K = 0 and internal forces sum to zero); a spinning body stays bounded; with
+ * implicit Euler the total energy never increases. */
+static void test_momentum_and_spin(void)
+{
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = 0;
+    wd.dt = 0.01;
+    sem_object_def od = sem_default_object_def();
+    od.initial_velocity[0] = 1.0;
+    od.initial_velocity[1] = -0.5;
+    od.initial_angular_velocity[2] = 2.0;
+    setup s;
+    if (!make_box_world(&s, 2, &wd, &od)) {
+        setup_free(&s);
+        return;
+    }
+    sem_object_stats st0, st;
+    sem_world_object_stats(s.world, 0, &st0);
+    sem_error err;
+    int steps = getenv("SEM_SANITIZED") ? 100 : 500, ok = 1;
+    for (int k = 0; k < steps && ok; ++k) ok = sem_world_step(s.world, &err) == SEM_OK;
+    CHECK(ok, "step failed: %s", err.message);
+    sem_world_object_stats(s.world, 0, &st);
+    double pnorm = st0.mass * hypot(1.0, 0.5);
+    for (int k = 0; k < 3; ++k) CHECK_NEAR(st.linear_momentum[k], st0.linear_momentum[k], 1e-10 * pnorm);
+    CHECK(isfinite(st.kinetic_energy) && st.kinetic_energy <= 1.01 * st0.kinetic_energy,
+          "spinning body blew up: KE %g -> %g", st0.kinetic_energy, st.kinetic_energy);
+    CHECK(st.kinetic_energy > 0.5 * st0.kinetic_energy, "spin died out: KE %g -> %g", st0.kinetic_energy,
+          st.kinetic_energy);
+    setup_free(&s);
+
+    wd.integrator = SEM_IMPLICIT_EULER;
+    if (!make_box_world(&s, 2, &wd, &od)) {
+        setup_free(&s);
+        return;
+    }
+    sem_world_object_stats(s.world, 0, &st0);
+    double E_prev = st0.kinetic_energy + st0.elastic_energy + st0.error_energy;
+    int increases = 0;
+    steps = getenv("SEM_SANITIZED") ? 30 : 150;
+    for (int k = 0; k < steps && ok; ++k) {
+        ok = sem_world_step(s.world, &err) == SEM_OK;
+        sem_world_object_stats(s.world, 0, &st);
+        double E = st.kinetic_energy + st.elastic_energy + st.error_energy;
+        if (E > E_prev * (1 + 1e-9)) increases++;
+        E_prev = E;
+    }
+    CHECK(ok, "implicit step failed: %s", err.message);
+    CHECK(increases == 0, "total energy increased in %d implicit Euler steps", increases);
+    setup_free(&s);
+}
+
+/* Patch test (Fig. 9): every control point prescribed by an affine map; the elastic
+ * energy equals psi(A) x volume; zero for a rotation. */
+static void patch_test(sem_model *model, const char *what)
+{
+    sem_error err;
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.order = 2;
+    sem_discretization *disc = NULL;
+    if (sem_preprocess(model, &po, &disc, &err) != SEM_OK) {
+        CHECK(0, "%s: preprocess: %s", what, err.message);
+        return;
+    }
+    double A[3][12] = {
+        {1.2, 0.1, 0.0, 0.3, 0.05, 0.9, 0.1, -0.2, 0.0, 0.02, 1.1, 0.5}, /* stretch + shear */
+        {1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0},   /* simple shear */
+        {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},                           /* rotation, below */
+    };
+    double ang = 0.7, c = cos(ang), s = sin(ang);
+    double R[12] = {c, -s, 0, 1.0, s, c, 0, 2.0, 0, 0, 1, -0.5};
+    memcpy(A[2], R, sizeof R);
+    for (int k = 0; k < 3; ++k) {
+        sem_world_def wd = sem_default_world_def();
+        wd.gravity[2] = 0;
+        wd.integrator = SEM_STATIC;
+        sem_world *w = sem_world_create(&wd, &err);
+        sem_object_def od = sem_default_object_def();
+        od.model = model;
+        od.disc = disc;
+        od.prescribe.type = SEM_PRESCRIBE_AFFINE;
+        memcpy(od.prescribe.affine, A[k], sizeof R);
+        int id = sem_world_add_object(w, &od, &err);
+        CHECK(id == 0, "%s: %s", what, err.message);
+        if (id == 0) {
+            CHECK(sem_world_solve_static(w, &err) == SEM_OK, "%s: %s", what, err.message);
+            sem_object_stats st;
+            sem_world_object_stats(w, 0, &st);
+            sem_material mat = od.material;
+            sem_material_init(&mat, &err);
+            double F[9] = {A[k][0], A[k][1], A[k][2], A[k][4], A[k][5], A[k][6], A[k][8], A[k][9], A[k][10]};
+            double psi = sem_material_energy(&mat, F, NULL, NULL);
+            if (k < 2)
+                CHECK_REL(st.elastic_energy, psi * st.volume, 1e-8);
+            else
+                CHECK_NEAR(st.elastic_energy, 0.0, 1e-10 * mat.mu * st.volume);
+            CHECK_NEAR(st.error_energy, 0.0, 1e-10 * (st.elastic_energy + mat.mu * st.volume));
+        }
+        sem_world_destroy(w);
+    }
+    sem_discretization_destroy(disc);
+}
+
+static void test_patch(void)
+{
+    sem_error err;
+    sem_model *box = sem_model_create();
+    sem_box_def bd = sem_default_box_def();
+    if (sem_primitive_box(box, &bd, &err) == SEM_OK) patch_test(box, "box");
+    sem_model_destroy(box);
+    const char *path = test_shared_model("rounded_cube.iges");
+    if (path) {
+        sem_model *m = NULL;
+        if (sem_model_load(path, &m, &err) == SEM_OK)
+            patch_test(m, "rounded_cube");
+        else
+            CHECK(0, "rounded_cube: %s", err.message);
+        sem_model_destroy(m);
+    }
+}
+
+/* Bad world definitions are errors. */
+static void test_bad_world(void)
+{
+    sem_error err;
+    sem_world_def wd = sem_default_world_def();
+    wd.dt = 0;
+    CHECK(sem_world_create(&wd, &err) == NULL, "dt = 0 accepted");
+    CHECK(strstr(err.message, "dt") != NULL, "%s", err.message);
+    wd.dt = -1;
+    CHECK(sem_world_create(&wd, &err) == NULL, "dt < 0 accepted");
+}
+
+int main(void)
+{
+    test_free_fall();
+    test_momentum_and_spin();
+    test_patch();
+    test_bad_world();
+    return test_finish("test_simulation");
+}
