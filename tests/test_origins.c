@@ -131,6 +131,14 @@ static void test_hand_case(void)
     CHECK(sem_step_origins(NULL, &d, &err) == SEM_ERR_INVALID, "W column");
     free_origins(&d);
     sem_csr_free(&d.W);
+
+    /* no quadrature points at all: every part is isolated, at its own sample centroid */
+    d.n_quad = 0;
+    d.quad_X = NULL;
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
+    CHECK(d.n_origins == 5, "empty W: %d origins", d.n_origins);
+    if (d.n_origins == 5) CHECK_NEAR(d.origin_X[3 * 3 + 0], 8.0, 1e-12);
+    free_origins(&d);
 }
 
 /* xorshift: reproducible random numbers */

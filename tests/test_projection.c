@@ -453,6 +453,73 @@ static void test_planar_square(void)
     }
 }
 
+/* a full circle as 4 rational quadratic arcs (9 control points), for a trim hole */
+static void hole_everywhere(sem_part *part)
+{
+    part->n_holes = 1;
+    part->holes = calloc(1, sizeof *part->holes);
+    part->holes[0].n_curves = 1;
+    part->holes[0].curves = calloc(1, sizeof(sem_curve));
+    sem_curve *c = &part->holes[0].curves[0];
+    sem_curve_alloc(c, 2, 9);
+    double k[12] = {0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4};
+    memcpy(c->knots, k, sizeof k);
+    double p[9][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}, {1, 0}};
+    for (int i = 0; i < 9; ++i) {
+        c->ctrl[3 * i] = 0.5 + 5 * p[i][0]; /* radius 5 around the centre of [0,1]^2 */
+        c->ctrl[3 * i + 1] = 0.5 + 5 * p[i][1];
+        c->weights[i] = (i % 2) ? sqrt(0.5) : 1.0;
+    }
+    c->t0 = 0;
+    c->t1 = 4;
+}
+
+/* A part trimmed away entirely has no samples: sharing an origin, its fit comes from the
+ * group (exact for affine motions); alone, its Pi rows are still finite. */
+static void test_part_without_samples(void)
+{
+    sem_model *m = box_model();
+    double o[3] = {0.5, 0.2, 1.3}, e1[3] = {0.5, 0, 0}, e2[3] = {0, 0.5, 0};
+    sem_part part;
+    planar_part(&part, o, e1, e2, 2, 1);
+    hole_everywhere(&part);
+    sem_model_take_part(m, &part, NULL);
+    for (int order = 1; order <= 2; ++order) {
+        sem_discretization d;
+        sem_error err;
+        sem_status st = make_disc(m, (const int[]){0, 0, 1, 1, 2, 2, 0}, order, &d, &err);
+        CHECK(st == SEM_OK, "%s", err.message);
+        if (st != SEM_OK) continue;
+        int n6 = 0;
+        for (int s = 0; s < d.n_samples; ++s) n6 += d.sample_part[s] == 6;
+        CHECK(n6 == 0, "part 6 trimmed away, has %d samples", n6);
+        st = sem_step_projection(NULL, &d, &err);
+        CHECK(st == SEM_OK, "%s", err.message);
+        if (st == SEM_OK) {
+            patch_result r = patch_test(m, &d, (const int[]){1, 1, 1, 1, 1, 1, 1});
+            CHECK(r.checked_full == 7, "full %d", r.checked_full);
+            CHECK_NEAR(r.c1_err, 0, 1e-10);
+            CHECK_NEAR(r.c2_err, 0, 1e-10);
+            CHECK_NEAR(r.t_err, 0, 1e-12);
+        }
+        sem_csr_free(&d.Pi);
+        /* alone in its own group (no area at all): finite rows */
+        d.part_origin[6] = 3;
+        d.n_origins = 4;
+        d.origin_X = realloc(d.origin_X, 12 * sizeof(double));
+        d.origin_X[9] = d.origin_X[10] = d.origin_X[11] = 0.0;
+        st = sem_step_projection(NULL, &d, &err);
+        CHECK(st == SEM_OK, "%s", err.message);
+        if (st == SEM_OK) {
+            int finite = 1;
+            for (size_t k = 0; k < sem_csr_nnz(&d.Pi); ++k) finite &= isfinite(d.Pi.val[k]);
+            CHECK(finite, "finite Pi for a part without samples");
+        }
+        free_disc(&d);
+    }
+    sem_model_destroy(m);
+}
+
 /* Bad inputs: an origin that is not its group's centroid, missing origins, bad order. */
 static void test_errors(void)
 {
@@ -605,6 +672,7 @@ int main(void)
     test_box_patch();
     test_matches_dense_least_squares();
     test_planar_square();
+    test_part_without_samples();
     test_errors();
     test_shared_models();
     test_pipeline_origins();

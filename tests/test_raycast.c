@@ -8,6 +8,7 @@
 
 #include "preprocess/raycast.h"
 #include "sem/model.h"
+#include "sem/primitives.h"
 #include "test_util.h"
 
 /* Adds the patch x(u,v) = o + u a + v b, u,v in [0,1], of degree `degree` (evenly spaced
@@ -78,10 +79,15 @@ static void test_cube(int degree, int resolution)
     /* winding number: 1 inside, 0 outside; the uncorrected flipped face would give 2/3 */
     const double centre[3] = {0.5, 0.5, 0.5}, inside[3] = {0.9, 0.15, 0.7};
     const double outside[3] = {2.0, 0.5, 0.5}, outside2[3] = {0.5, -0.3, 1.2};
-    CHECK_NEAR(sem_raycast_winding_number(scene, centre), 1.0, 1e-10);
-    CHECK_NEAR(sem_raycast_winding_number(scene, inside), 1.0, 1e-10);
-    CHECK_NEAR(sem_raycast_winding_number(scene, outside), 0.0, 1e-10);
-    CHECK_NEAR(sem_raycast_winding_number(scene, outside2), 0.0, 1e-10);
+    CHECK_NEAR(sem_raycast_winding_number_exact(scene, centre), 1.0, 1e-10);
+    CHECK_NEAR(sem_raycast_winding_number_exact(scene, inside), 1.0, 1e-10);
+    CHECK_NEAR(sem_raycast_winding_number_exact(scene, outside), 0.0, 1e-10);
+    CHECK_NEAR(sem_raycast_winding_number_exact(scene, outside2), 0.0, 1e-10);
+    /* the fast (tree) version: within its far-field error */
+    CHECK_NEAR(sem_raycast_winding_number(scene, centre), 1.0, 2e-3);
+    CHECK_NEAR(sem_raycast_winding_number(scene, inside), 1.0, 2e-3);
+    CHECK_NEAR(sem_raycast_winding_number(scene, outside), 0.0, 2e-3);
+    CHECK_NEAR(sem_raycast_winding_number(scene, outside2), 0.0, 2e-3);
 
     /* first hit from outside along +x: the x = 0 face at t = 1, normal -x */
     sem_ray_hit h;
@@ -202,7 +208,46 @@ static void test_inverted_solid(void)
     if (scene) {
         for (int p = 0; p < 6; p++) CHECK(sem_raycast_part_sign(scene, p) == -1, "part %d", p);
         const double c[3] = {3.5, 0.5, 0.5};
-        CHECK_NEAR(sem_raycast_winding_number(scene, c), 1.0, 1e-10);
+        CHECK_NEAR(sem_raycast_winding_number_exact(scene, c), 1.0, 1e-10);
+    }
+    sem_raycast_scene_destroy(scene);
+    sem_model_destroy(m);
+}
+
+/* Fast (tree) winding number against the exact sum on a sphere and an open hemisphere-like
+ * patch, at points away from the surface. */
+static void test_fast_winding(void)
+{
+    sem_model *m = sem_model_create();
+    sem_sphere_def sd = sem_default_sphere_def();
+    sem_error err;
+    CHECK(sem_primitive_sphere(m, &sd, &err) == SEM_OK, "sphere");
+    /* an open sheet too (the cube's x = 0 face moved away) */
+    const double o[3] = {2, -1, -1}, a[3] = {0, 0, 2}, b[3] = {0, 2, 0};
+    add_patch(m, o, a, b, 3);
+    sem_raycast_scene *scene = NULL;
+    CHECK(sem_raycast_scene_build(m, 16, &scene, &err) == SEM_OK, "build: %s", err.message);
+    if (scene) {
+        double worst = 0;
+        unsigned seed = 12345;
+        for (int k = 0; k < 400; k++) {
+            double X[3];
+            for (int d = 0; d < 3; d++) {
+                seed = seed * 1103515245u + 12345u;
+                X[d] = -3.0 + 6.0 * (double)(seed >> 8) / (double)(1u << 24);
+            }
+            double r = sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]);
+            if (fabs(r - 1) < 0.05 || fabs(X[0] - 2) < 0.05) continue;
+            double fast = sem_raycast_winding_number(scene, X);
+            double exact = sem_raycast_winding_number_exact(scene, X);
+            if (fabs(fast - exact) > worst) worst = fabs(fast - exact);
+            if (r < 0.95) CHECK(fabs(exact - 1) < 0.2 || fabs(X[0] - 2) < 1, "inside %g", exact);
+        }
+        printf("fast winding number: worst difference %.3g\n", worst);
+        CHECK(worst < 5e-3, "fast vs exact winding number %g", worst);
+        const double c[3] = {0, 0, 0};
+        CHECK_NEAR(sem_raycast_winding_number_exact(scene, c) -
+                       sem_raycast_winding_number(scene, c), 0.0, 5e-3);
     }
     sem_raycast_scene_destroy(scene);
     sem_model_destroy(m);
@@ -226,6 +271,7 @@ int main(void)
     test_cube(1, 4);
     test_cube(3, 5);
     test_inverted_solid();
+    test_fast_winding();
     test_errors();
     return test_finish("raycast");
 }

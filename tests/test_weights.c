@@ -407,6 +407,33 @@ static void test_shared_beam(void)
     check_partition_of_unity(&W, "beam_cmp3_b");
     sem_csr_free(&W);
     free(X);
+
+    /* the step on the real quadrature points and samples, authors' settings (models
+     * README: alpha 0.51, rays 3 x 3, 15 points per interval) */
+    sem_preprocess_options o = sem_default_preprocess_options();
+    o.alpha = 0.51;
+    o.rays[0] = o.rays[1] = 3;
+    o.points_per_interval = 15;
+    sem_discretization *d = calloc(1, sizeof *d);
+    sem_status st = sem_step_sample(m, d, &err);
+    if (st == SEM_OK) st = sem_step_quadrature(m, scene, &o, d, &err);
+    if (st == SEM_OK) st = sem_step_weights(m, scene, &o, d, &err);
+    CHECK(st == SEM_OK, "beam steps: %s", err.message);
+    if (st == SEM_OK) {
+        CHECK(d->n_quad > 0 && d->W.n_rows == d->n_quad && d->W.n_cols == d->n_parts, "W shape");
+        check_partition_of_unity(&d->W, "beam_cmp3_b quadrature");
+        check_partition_of_unity(&d->W_samples, "beam_cmp3_b samples");
+        int own_ok = 1;
+        for (int k = 0; k < d->n_samples; ++k) {
+            double w = weight_of(&d->W_samples, k, d->sample_part[k]);
+            int len = d->W_samples.row_start[k + 1] - d->W_samples.row_start[k];
+            own_ok &= len >= 1 && fabs(w - 1.0 / len) <= 1e-12;
+        }
+        CHECK(own_ok, "samples: own part weight is not 1 / (parts through the sample)");
+        printf("beam_cmp3_b step: %d quadrature points, %d samples, nnz %.1f%%\n", d->n_quad,
+               d->n_samples, 100.0 * d->weight_nonzero_fraction);
+    }
+    sem_discretization_destroy(d);
     sem_raycast_scene_destroy(scene);
     sem_model_destroy(m);
 }

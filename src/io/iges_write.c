@@ -283,7 +283,8 @@ static int write_curve(iges_writer *w, const sem_curve *c, const char *label, in
 static int write_loop(iges_writer *w, const sem_trim_loop *loop, int surface_de, const char *label,
                       int color)
 {
-    int *curve_de = malloc((size_t)loop->n_curves * sizeof *curve_de);
+    if (loop->n_curves < 1) return 0; /* rejected by validate_model before */
+    int *curve_de = calloc((size_t)loop->n_curves, sizeof *curve_de);
     if (!curve_de) {
         w->failed = 1;
         return 0;

@@ -168,7 +168,7 @@ static sem_status parse_int(obj_reader *r, const char *tok, long *out)
 static sem_status resolve_index(obj_reader *r, const char *tok, size_t count, const char *what,
                                 int *out)
 {
-    long i;
+    long i = 0;
     sem_status st = parse_int(r, tok, &i);
     if (st != SEM_OK) return st;
     long resolved = i > 0 ? i - 1 : (long)count + i;
@@ -415,7 +415,7 @@ static sem_status statement_surf(obj_reader *r, int ntok, char **tok)
         if (st != SEM_OK) return st;
     }
     for (int i = 5; i < ntok; ++i) {
-        int idx;
+        int idx = 0;
         st = resolve_index(r, tok[i], r->v.n / 4, "vertex", &idx);
         if (st != SEM_OK) return st;
         for (int k = 0; k < 4; ++k)
@@ -430,7 +430,7 @@ static sem_status statement_curv2(obj_reader *r, int ntok, char **tok)
     if (st != SEM_OK) return st;
     if (ntok < 3) return parse_error(r, SEM_ERR_PARSE, "curv2 needs at least 2 control points");
     for (int i = 1; i < ntok; ++i) {
-        int idx;
+        int idx = 0;
         st = resolve_index(r, tok[i], r->vp.n / 3, "parameter vertex (vp)", &idx);
         if (st != SEM_OK) return st;
         for (int k = 0; k < 3; ++k)
@@ -458,7 +458,7 @@ static sem_status statement_parm(obj_reader *r, int ntok, char **tok)
     }
     a->n = 0;
     for (int i = 2; i < ntok; ++i) {
-        double x;
+        double x = 0.0;
         sem_status st = parse_real(r, tok[i], &x);
         if (st != SEM_OK) return st;
         if (!push_double(a, x)) return no_memory(r);
@@ -498,7 +498,7 @@ static sem_status statement_trim(obj_reader *r, int ntok, char **tok, int is_hol
         sem_status st = parse_real(r, tok[1 + 3 * i], &t->t0);
         if (st == SEM_OK) st = parse_real(r, tok[2 + 3 * i], &t->t1);
         if (st != SEM_OK) return st;
-        long idx;
+        long idx = 0;
         st = parse_int(r, tok[3 + 3 * i], &idx);
         if (st != SEM_OK) return st;
         if (idx == 0)
@@ -584,7 +584,7 @@ static sem_status statement_deg(obj_reader *r, int ntok, char **tok)
     if (ntok < 2 || ntok > 3) return parse_error(r, SEM_ERR_PARSE, "deg needs 'du [dv]'");
     int d[2] = {0, 0};
     for (int i = 1; i < ntok; ++i) {
-        long x;
+        long x = 0;
         sem_status st = parse_int(r, tok[i], &x);
         if (st != SEM_OK) return st;
         if (strchr(tok[i], '/') || x < 1 || x > SEM_MAX_DEGREE)

@@ -37,6 +37,7 @@
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "linear_solver.h"
@@ -1207,15 +1208,16 @@ static sem_status newton_solve(sem_world *w, object *o, double h, sem_error *err
         scatter_free(o, fr, dq);
         double slope = 0;
         for (size_t i = 0; i < n; ++i) slope -= dq[i] * g[i];
-        double E0;
-        ENERGY(o->q, E0);
-        double step = 1.0, Et = INFINITY;
+        /* ENERGY uses dq as scratch: keep the Newton direction apart */
         double *dir = malloc(n * sizeof(double));
         if (!dir) {
             st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
             goto done;
         }
         memcpy(dir, dq, n * sizeof(double));
+        double E0;
+        ENERGY(o->q, E0);
+        double step = 1.0, Et = INFINITY;
         for (int ls = 0; ls < 40; ++ls) {
             for (size_t i = 0; i < n; ++i) qtry[i] = o->q[i] - step * dir[i];
             ENERGY(qtry, Et);
@@ -1225,6 +1227,9 @@ static sem_status newton_solve(sem_world *w, object *o, double h, sem_error *err
         }
         double dmax = 0;
         for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
+        if (getenv("SEM_DEBUG_NEWTON"))
+            fprintf(stderr, "newton it %d: |g| %.6g E0 %.12g Et %.12g step %g slope %g dmax %g\n", it, gnorm, E0, Et,
+                    step, slope, dmax);
         free(dir);
         if (!isfinite(Et)) {
             st = sem_error_set(err, SEM_ERR_NUMERIC,

@@ -67,7 +67,9 @@ static uint64_t hash_columns(const int *col, int n)
 static sem_status validate(const sem_discretization *d, sem_error *err)
 {
     if (d->n_parts <= 0) return sem_error_set(err, SEM_ERR_INVALID, "origins: no parts");
-    if (d->n_quad < 0 || d->W.n_rows != d->n_quad || d->W.n_cols != d->n_parts ||
+    /* no quadrature points (a model without volume): W may be empty, all parts isolated */
+    const int empty = d->n_quad == 0 && d->W.n_rows == 0;
+    if (d->n_quad < 0 || d->W.n_rows != d->n_quad || (!empty && d->W.n_cols != d->n_parts) ||
         (d->n_quad > 0 && (!d->W.row_start || !d->quad_X)))
         return sem_error_set(err, SEM_ERR_INVALID,
                              "origins: W is %d x %d, expected %d quadrature points x %d parts",

@@ -389,6 +389,7 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     st = sem_step_weights(model, scene, &o, d, err);
     if (st != SEM_OK) goto done;
     st = sem_step_origins(model, d, err);
+    if (st == SEM_OK) st = sem_merge_degenerate_origins(d, err);
     if (st != SEM_OK) goto done;
     double t3 = omp_get_wtime();
     d->timings.weights_s = t3 - t2;

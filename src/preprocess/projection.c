@@ -572,8 +572,12 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
         }
     }
 
+    /* Threads only pay off for large inputs: small models (most of Table 1) take well under
+     * a millisecond, less than a fork/join on a busy machine. */
+    const int parallel = d->n_samples > 20000 || nnz > 200000;
+
     /* rest moments -> length scale L_j and the origin consistency check */
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if (parallel)
     for (int i = 0; i < n_parts; ++i) part_rest_moments(&cx, i);
     for (int j = 0; j < n_origins; ++j) {
         group *g = &cx.groups[j];
@@ -614,7 +618,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
         ps->S2 = order == 2 ? calloc(N2 * (nc ? nc : 1), sizeof *ps->S2) : NULL;
         if (!ps->T || !ps->S1 || (order == 2 && !ps->S2)) goto nomem;
     }
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if (parallel)
     for (int i = 0; i < n_parts; ++i) part_fit_moments(&cx, i);
     for (int j = 0; j < n_origins; ++j)
         if (group_sums(&cx, j) != SEM_OK) goto nomem;
@@ -627,7 +631,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
             Pi.row_start[row + 1] = Pi.row_start[row] + cx.groups[d->part_origin[i]].n_cols;
         }
     int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (parallel)
     for (int i = 0; i < n_parts; ++i)
         if (part_solve(&cx, i, &Pi, group_cols + group_cols_start[d->part_origin[i]]) != SEM_OK)
             failed = 1;

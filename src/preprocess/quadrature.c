@@ -19,11 +19,18 @@
  *    to 0 at the end of the ray. Open surfaces (the rocket has no bottom, the starship is
  *    12 open pieces), gaps (the chicken) or a misoriented part break that. Such a ray falls
  *    back to the generalized winding number (Jacobson et al. 2013) at the midpoint of each
- *    segment between consecutive hits: inside when > 1/2. The winding number degrades
+ *    segment between consecutive hits, and of the two end segments between the bounding
+ *    box and the first/last hit (a ray along the starship enters its open back end
+ *    without any hit): inside when > 1/2. The winding number degrades
  *    gracefully across holes and gaps (it is the harmonic extension of the inside
  *    indicator), which parity or counting cannot do; it costs O(triangles) per segment, so
  *    it is used only on the rays that need it.
- * 3. Hits on shared edges, duplicate reports and grazing touches are already merged by
+ * 3. A consistent count can still be wrong (two open sheets facing each other, as the
+ *    castle's walls, count as one solid): an inside segment whose midpoint winding number
+ *    is below 1/4 (clearly outside) is dropped. The inside of an open-ended solid (the
+ *    rocket's tube, a lamp shade) keeps winding numbers near or above 1/2, so such solids
+ *    keep their counted volume, which is what the modeller meant.
+ * 4. Hits on shared edges, duplicate reports and grazing touches are already merged by
  *    sem_raycast_all into single crossings (see raycast.c).
  *
  * Material (quad_part): a stack of entered parts along the ray: push the part on entering;
@@ -41,6 +48,9 @@
 #include <string.h>
 
 #include "steps.h"
+
+#define WINDING_INSIDE 0.5 /* fallback: inside when the winding number is above */
+#define WINDING_VETO 0.25  /* consistent counting: outside when the winding number is below */
 
 typedef struct ray_points {
     int n;
@@ -143,6 +153,19 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
     }
     if (depth != 0) consistent = 0;
 
+    /* a consistent count can still be wrong: two open sheets whose normals happen to face
+     * each other (the castle's walls) look like one solid. Veto an inside segment whose
+     * midpoint is clearly outside by the winding number (< 1/4; the inside of an open
+     * tube or shade stays >= ~1/2, so open-ended solids keep their counted volume). */
+    if (consistent) {
+        for (int i = 1; i < n; i++) {
+            if (!seg[i].inside || !(seg[i].t1 > seg[i].t0)) continue;
+            double tm = 0.5 * (seg[i].t0 + seg[i].t1), X[3];
+            for (int d = 0; d < 3; d++) X[d] = origin[d] + tm * dir[d];
+            if (sem_raycast_winding_number(scene, X) < WINDING_VETO) seg[i].inside = 0;
+        }
+    }
+
     /* 2. fallback: winding number at each segment's midpoint, including the two end
      * segments (a ray may enter an open tube through its open end without a hit) */
     if (!consistent) {
@@ -156,7 +179,7 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
             if (!(seg[i].t1 > seg[i].t0)) continue;
             double tm = 0.5 * (seg[i].t0 + seg[i].t1), X[3];
             for (int d = 0; d < 3; d++) X[d] = origin[d] + tm * dir[d];
-            seg[i].inside = sem_raycast_winding_number(scene, X) > 0.5;
+            seg[i].inside = sem_raycast_winding_number(scene, X) > WINDING_INSIDE;
         }
     }
 

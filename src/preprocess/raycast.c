@@ -23,22 +23,34 @@
  *   (entering minus leaving) and vanishes when that is zero (a ray grazing a fold touches
  *   the surface without crossing it). Within one t, entering hits sort before leaving ones,
  *   so touching solids make one union interval.
+ * - Exact hits. sem_raycast_all (used by the quadrature) moves every hit onto the exact
+ *   NURBS surface by Newton's method on S(u,v) = o + t d, started from the hit triangle's
+ *   interpolated (u,v); it keeps the triangle's t when Newton fails (collapsed poles,
+ *   grazing rays, trim edges). So intervals along a ray do not carry the tessellation's
+ *   chord error: a sphere's ray-cast volume is the exact midpoint rule across the ray
+ *   grid (0.82% at 10 x 10 rays, 0.076% at 40 x 40) for any tessellation that does not
+ *   miss the ray near the silhouette. sem_raycast_first keeps the triangle's t (cheap; the
+ *   weights only need distances).
  * - Orientation fix (part_sign). CAD files have inward faces. For each part we pick up to
  *   9 sample triangles (the largest triangle of each of 9 equal slices of the part's
- *   triangle list, so the samples spread over the part) and cast 5 rays from each centre:
- *   along the normal and 4 directions 25 degrees off it. A ray that leaves a closed solid
- *   crosses its boundary an even number of times (0, 2, ...) before escaping, a ray that
- *   points into the solid an odd number of times. Each ray votes +area (even: the normal
- *   points out) or -area (odd); the sign of the sum decides, ties keep +1. Rays, not one
- *   ray, because a ray may escape through a gap or the open end of an open model (the
- *   rocket has no bottom) or cross an embedded part (the mug's handle): a majority of
- *   jittered rays from several places is robust to such accidents.
+ *   triangle list, so the samples spread over the part) and from each centre cast 5 pairs
+ *   of opposite rays: along +-normal and 4 directions 25 degrees off it. A ray that leaves
+ *   a closed solid crosses its boundary an even number of times before escaping, a ray
+ *   into it an odd number. Crossings are counted first on the part's own *component*
+ *   (parts whose boundaries touch, within 5e-3 of the model size: a box's 6 patches), so
+ *   a solid nested in or overlapping another one (the tire's hub, the mug's embedded
+ *   handle, the rocket's fins) is judged on its own surface. A pair is decisive when one
+ *   ray is even and the other odd; when the component gives no decision (an open sheet,
+ *   a gap) the counts on the whole scene are tried. Each decisive pair votes +-area
+ *   (+ when the +normal ray is even); the sign of the sum decides, ties keep +1. Several
+ *   jittered pairs from several places outvote accidents: a ray escaping through a gap or
+ *   an open end (the rocket has no bottom) or grazing an edge.
  * - Generalized winding number (Jacobson et al. 2013): the sum over the orientation-
  *   corrected triangles of their signed solid angles seen from X (Van Oosterom & Strackee
  *   1983: tan(Omega/2) = det[a b c] / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|)),
- *   divided by 4 pi. Exact, O(triangles) per query; the quadrature only calls it for the
- *   segments of rays whose enter/leave counting is inconsistent, and callers thread over
- *   queries (the function is re-entrant).
+ *   divided by 4 pi. sem_raycast_winding_number_exact sums every triangle;
+ *   sem_raycast_winding_number uses Barill et al.'s (2018) tree with a first-order
+ *   (dipole) far field, within 5e-3 of the exact value (see below). Both re-entrant.
  * - Closest parts: rtcPointQuery with a callback that computes the exact double-precision
  *   point-triangle distance (Ericson, Real-Time Collision Detection, 5.1.5) and keeps the
  *   minimum per part within the radius, in a per-call context (thread-safe).
@@ -117,6 +129,11 @@ struct sem_raycast_scene {
     double *tri_normal;   /* 3 per triangle: unit (v1-v0)x(v2-v0), before the fix */
     double *tri_area;     /* per triangle */
     double *tri_uv;       /* 6 per triangle: (u,v) of v0, v1, v2 */
+    /* fast winding number tree (see sem_raycast_winding_number) */
+    struct winding_node *winding_nodes;
+    int n_winding_nodes;
+    int *winding_order;       /* triangle indices in tree order */
+    signed char *winding_sign; /* part_sign of each triangle */
     sem_surface *surfaces; /* copies of the parts' surfaces, for exact hit refinement */
     double lo[3], hi[3];
     double scale;         /* bounding-box diagonal (> 0) */
@@ -189,7 +206,7 @@ static int refine_hit(const sem_raycast_scene *s, int part, int global, const do
             return 1;
         }
         double bc[3], rhs[3] = {-F[0], -F[1], -F[2]}, tmp[3];
-        cross3(Su, c, tmp); /* unused order check below uses Cramer's rule on [Su Sv c] */
+        /* Cramer's rule on [Su Sv c] (du dv dt) = rhs */
         cross3(Sv, c, bc);
         double det = dot3(Su, bc);
         double scale = sqrt(dot3(Su, Su) * dot3(Sv, Sv));
@@ -589,25 +606,177 @@ int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3],
 
 /* ---- generalized winding number ---- */
 
-double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
+/* Signed solid angle of triangle v (9 doubles) seen from X (Van Oosterom-Strackee). */
+static double solid_angle(const double *v, const double *X)
+{
+    double a[3], b[3], c[3], bc[3];
+    sub3(v, X, a);
+    sub3(v + 3, X, b);
+    sub3(v + 6, X, c);
+    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), lc = sqrt(dot3(c, c));
+    cross3(b, c, bc);
+    double det = dot3(a, bc);
+    double den = la * lb * lc + dot3(a, b) * lc + dot3(b, c) * la + dot3(c, a) * lb;
+    return 2.0 * atan2(det, den);
+}
+
+double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const double X[3])
 {
     if (!scene || !X) return 0.0;
     double total = 0.0;
     for (int part = 0; part < scene->n_parts; part++) {
         double sum = 0.0;
-        for (int t = scene->part_tri_offset[part]; t < scene->part_tri_offset[part + 1]; t++) {
-            const double *v = scene->tri + 9 * (size_t)t;
-            double a[3], b[3], c[3], bc[3];
-            sub3(v, X, a);
-            sub3(v + 3, X, b);
-            sub3(v + 6, X, c);
-            double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), lc = sqrt(dot3(c, c));
-            cross3(b, c, bc);
-            double det = dot3(a, bc);
-            double den = la * lb * lc + dot3(a, b) * lc + dot3(b, c) * la + dot3(c, a) * lb;
-            sum += 2.0 * atan2(det, den); /* signed solid angle (Van Oosterom-Strackee) */
-        }
+        for (int t = scene->part_tri_offset[part]; t < scene->part_tri_offset[part + 1]; t++)
+            sum += solid_angle(scene->tri + 9 * (size_t)t, X);
         total += scene->part_sign[part] * sum;
+    }
+    return total / (4.0 * M_PI);
+}
+
+/* Fast winding number (Barill et al. 2018, first order): a BVH over the orientation-
+ * corrected triangles; a node seen from farther than WINDING_BETA times its radius
+ * contributes as a dipole, N . (p - X) / |p - X|^3 with N the sum of area-weighted
+ * normals and p the area-weighted centroid; nearer nodes recurse, leaves are exact. With
+ * only the first-order term we take a conservative beta = 6 (Barill et al. use 2 with
+ * second-order terms): the measured difference to the exact sum stays below 5e-3
+ * (test_raycast), far below what the 1/2 threshold needs, and the castle's quadrature
+ * drops from 0.42 s (exact) to 0.013 s. */
+#define WINDING_BETA 6.0
+#define WINDING_LEAF 8
+
+typedef struct winding_node {
+    double p[3];       /* area-weighted centroid */
+    double N[3];       /* sum of area x corrected unit normal */
+    double radius;     /* max distance from p to the node's vertices */
+    int left, right;   /* children, -1 for a leaf */
+    int first, count;  /* leaf: range in winding_order */
+} winding_node;
+
+static int build_winding_node(sem_raycast_scene *s, double *centroid, int first, int count)
+{
+    int id = s->n_winding_nodes++;
+    winding_node *node = &s->winding_nodes[id];
+    double area = 0, p[3] = {0, 0, 0}, N[3] = {0, 0, 0}, lo[3], hi[3];
+    for (int d = 0; d < 3; d++) {
+        lo[d] = INFINITY;
+        hi[d] = -INFINITY;
+    }
+    for (int k = first; k < first + count; k++) {
+        int t = s->winding_order[k];
+        double at = s->tri_area[t], sg = s->winding_sign[t];
+        for (int d = 0; d < 3; d++) {
+            p[d] += at * centroid[3 * (size_t)t + d];
+            N[d] += sg * at * s->tri_normal[3 * (size_t)t + d];
+            double c = centroid[3 * (size_t)t + d];
+            if (c < lo[d]) lo[d] = c;
+            if (c > hi[d]) hi[d] = c;
+        }
+        area += at;
+    }
+    for (int d = 0; d < 3; d++) p[d] /= area;
+    double r2 = 0;
+    for (int k = first; k < first + count; k++) {
+        const double *v = s->tri + 9 * (size_t)s->winding_order[k];
+        for (int c = 0; c < 3; c++) {
+            double w[3];
+            sub3(v + 3 * c, p, w);
+            double q = dot3(w, w);
+            if (q > r2) r2 = q;
+        }
+    }
+    memcpy(node->p, p, sizeof p);
+    memcpy(node->N, N, sizeof N);
+    node->radius = sqrt(r2);
+    node->first = first;
+    node->count = count;
+    node->left = node->right = -1;
+    if (count <= WINDING_LEAF) return id;
+    /* split at the median of the longest centroid extent (nth by partial sort) */
+    int axis = 0;
+    for (int d = 1; d < 3; d++)
+        if (hi[d] - lo[d] > hi[axis] - lo[axis]) axis = d;
+    int half = count / 2;
+    int *o = s->winding_order + first;
+    /* quickselect on centroid[axis] */
+    int l = 0, r = count - 1;
+    while (l < r) {
+        double pivot = centroid[3 * (size_t)o[(l + r) / 2] + axis];
+        int i = l, j = r;
+        while (i <= j) {
+            while (centroid[3 * (size_t)o[i] + axis] < pivot) i++;
+            while (centroid[3 * (size_t)o[j] + axis] > pivot) j--;
+            if (i <= j) {
+                int tmp = o[i];
+                o[i] = o[j];
+                o[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (half <= j)
+            r = j;
+        else if (half >= i)
+            l = i;
+        else
+            break;
+    }
+    int left = build_winding_node(s, centroid, first, half);
+    int right = build_winding_node(s, centroid, first + half, count - half);
+    s->winding_nodes[id].left = left;
+    s->winding_nodes[id].right = right;
+    return id;
+}
+
+/* Builds the tree once part_sign is known. Returns 0 when out of memory. */
+static int build_winding_tree(sem_raycast_scene *s)
+{
+    int n = s->n_triangles;
+    s->winding_order = malloc((size_t)n * sizeof *s->winding_order);
+    s->winding_sign = malloc((size_t)n * sizeof *s->winding_sign);
+    s->winding_nodes = malloc((size_t)(2 * n) * sizeof *s->winding_nodes);
+    double *centroid = malloc((size_t)n * 3 * sizeof *centroid);
+    if (!s->winding_order || !s->winding_sign || !s->winding_nodes || !centroid) {
+        free(centroid);
+        return 0;
+    }
+    for (int p = 0; p < s->n_parts; p++)
+        for (int t = s->part_tri_offset[p]; t < s->part_tri_offset[p + 1]; t++)
+            s->winding_sign[t] = (signed char)s->part_sign[p];
+    for (int t = 0; t < n; t++) {
+        s->winding_order[t] = t;
+        const double *v = s->tri + 9 * (size_t)t;
+        for (int d = 0; d < 3; d++) centroid[3 * (size_t)t + d] = (v[d] + v[3 + d] + v[6 + d]) / 3;
+    }
+    s->n_winding_nodes = 0;
+    build_winding_node(s, centroid, 0, n);
+    free(centroid);
+    return 1;
+}
+
+double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
+{
+    if (!scene || !X) return 0.0;
+    if (!scene->winding_nodes) return sem_raycast_winding_number_exact(scene, X);
+    int stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    double total = 0.0;
+    while (top > 0) {
+        const winding_node *node = &scene->winding_nodes[stack[--top]];
+        double w[3];
+        sub3(node->p, X, w);
+        double d2 = dot3(w, w);
+        if (d2 > WINDING_BETA * WINDING_BETA * node->radius * node->radius) {
+            total += dot3(node->N, w) / (d2 * sqrt(d2)); /* dipole: solid angle */
+        } else if (node->left < 0 || top + 2 > 128) {
+            for (int k = node->first; k < node->first + node->count; k++) {
+                int t = scene->winding_order[k];
+                total += scene->winding_sign[t] * solid_angle(scene->tri + 9 * (size_t)t, X);
+            }
+        } else {
+            stack[top++] = node->right;
+            stack[top++] = node->left;
+        }
     }
     return total / (4.0 * M_PI);
 }
@@ -1045,6 +1214,10 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
     free(sign);
     free(component);
+    if (!build_winding_tree(s)) {
+        sem_raycast_scene_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "raycast: out of memory");
+    }
     *out = s;
     return SEM_OK;
 }
@@ -1060,6 +1233,9 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->tri_normal);
     free(scene->tri_area);
     free(scene->tri_uv);
+    free(scene->winding_nodes);
+    free(scene->winding_order);
+    free(scene->winding_sign);
     if (scene->surfaces)
         for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);
     free(scene->surfaces);

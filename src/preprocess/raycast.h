@@ -31,11 +31,13 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
 void sem_raycast_scene_destroy(sem_raycast_scene *scene);
 
 /* First hit from origin along unit direction dir for t in (t_near, t_far); returns 1 when
- * hit. Thread-safe. */
+ * hit. t is the double-precision ray-plane distance of the hit triangle. Thread-safe. */
 int sem_raycast_first(const sem_raycast_scene *scene, const double origin[3], const double dir[3],
                       double t_near, double t_far, sem_ray_hit *hit);
 /* All hits along the ray in (t_near, t_far), sorted by t; writes at most max_hits, returns
- * the total count. Thread-safe. */
+ * the total count. Hits are refined onto the exact NURBS surface (Newton from the
+ * triangle's (u,v)); hits of one part at (nearly) one t - shared edges and vertices of the
+ * tessellation - are merged into one crossing, touching ones removed. Thread-safe. */
 int sem_raycast_all(const sem_raycast_scene *scene, const double origin[3], const double dir[3],
                     double t_near, double t_far, sem_ray_hit *hits, int max_hits);
 /* Closest point on each part within radius of X: calls back per part with the smallest
@@ -46,6 +48,10 @@ int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3],
 /* Generalized winding number (Jacobson et al. 2013) of the orientation-corrected
  * tessellation at X: ~1 inside, ~0 outside, fractional near open boundaries. */
 double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3]);
+/* The same summed exactly over every triangle (O(triangles)); the function above uses
+ * Barill et al.'s (2018) tree with a dipole far field (see raycast.c), equal to this
+ * within ~5e-3 away from the surface. */
+double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const double X[3]);
 /* Bounding box of the tessellation: lo[3], hi[3]. */
 void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[3]);
 int sem_raycast_part_count(const sem_raycast_scene *scene);

@@ -249,7 +249,21 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
     for (int i = 0; i <= n_parts; ++i) ctrl_offset[i] = (int)offsets[i];
     free(offsets);
 
-#pragma omp parallel for schedule(dynamic, 1)
+    /* Threads only pay off beyond a few thousand samples: below that the fork/join (and,
+     * on a busy machine, waiting for the second thread to be scheduled) costs more than the
+     * work. The estimate counts spans from the control nets (an upper bound). */
+    double work = 0.0;
+    for (int i = 0; i < n_parts; ++i) {
+        const sem_part *part = &model->parts[i];
+        const sem_surface *s = &part->surface;
+        double spans = (double)(s->n_u - s->degree_u) * (double)(s->n_v - s->degree_v);
+        double points = (double)lobatto_points(s->degree_u) * lobatto_points(s->degree_v);
+        int trimmed = part->has_outer || part->n_holes > 0;
+        work += trimmed ? fmax(spans * points, SEM_TRIM_MIN_POINTS * SEM_TRIM_MIN_POINTS)
+                        : spans * points;
+    }
+    const int parallel = work > 4000.0 && n_parts > 1;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
     for (int i = 0; i < n_parts; ++i) sample_part(&model->parts[i], i, &parts[i]);
 
     /* first failure in part order, so the message does not depend on scheduling */

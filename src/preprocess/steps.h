@@ -14,7 +14,9 @@
 
 /* sampling.c: fills n_samples, sample_part, sample_uv, sample_X, sample_area, J_hat,
  * part_ctrl_offset, n_ctrl, n_parts. Order-of-degree+1 Gauss-Lobatto points per non-empty
- * knot span in each direction; trimmed parts keep only samples inside their trims. */
+ * knot span in each direction; trimmed parts keep only samples inside their trims, and
+ * their spans are subdivided to at least 24 points per direction so a small trimmed region
+ * is never missed. */
 sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_error *err);
 
 /* quadrature.c: fills n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11). */
@@ -32,6 +34,9 @@ sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const
 
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+/* origins_merge.c: merges every origin whose samples are flat (planar or collinear) into
+ * its most blended neighbour, so every linear fit is determined (affine-exact). */
+sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err);
 
 /* projection.c: fills Pi (Eq. 7), hierarchical, robust to ill-conditioned fits. */
 sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretization *d,

@@ -16,7 +16,8 @@
  *    part i itself *beyond X*. X* is the closest point of part i, so the open segment X* X
  *    cannot touch part i; a self hit closer than X can only be a single-precision re-hit of
  *    the triangles around X* (Embree works in float), so it is skipped and the ray is cast
- *    again from just past it.
+ *    again from just past it. Hits whose double-precision distance is below t_near (a part
+ *    through X* itself) are skipped the same way.
  *  - X on a part (d_primary <= 1e-6 x model extent): theta = 1 for every part through X
  *    (equal weights on an intersection line or a shared edge) and 0 for all others, with
  *    no secondary rays. This is Eq. 8 in exact arithmetic: the secondary ray of any other
@@ -33,10 +34,15 @@
  *  - The threshold never empties a row: the largest weight is always kept.
  *
  * alpha: explicit (> 0), or found by bisection so that nnz(W) / (n_quad n_parts) approaches
- * the target sparsity T, or 0.5 x the bounding-box diagonal. theta depends on alpha only
- * through "d_primary <= alpha" and min(d_total, alpha), so the expensive part (closest points
- * and secondary rays) is computed once at the largest radius of the search and every
- * bisection step only re-evaluates Eq. 8-9 on the stored distances.
+ * the target sparsity T (stop when within 1% of T, relative, or after 30 halvings; keep the
+ * alpha whose fraction came closest), or 0.5 x the bounding-box diagonal. A T that even
+ * alpha = diagonal does not reach (occlusion zeroes many theta) gets alpha = diagonal, the
+ * densest W the model allows. theta depends on alpha only through "d_primary <= alpha" and
+ * min(d_total, alpha), so the expensive part (closest points and secondary rays) is
+ * computed once at the largest radius of the search and every bisection step only
+ * re-evaluates Eq. 8-9 on the stored distances; W is then built from the same distances.
+ * The bisection's nnz is not exactly monotone in alpha (the threshold and renormalisation
+ * act per row), which is harmless for a search that keeps the best alpha seen.
  *
  * Threads: OpenMP over points; each point's candidates and row depend on that point only and
  * are merged serially in point order, so W is identical for any thread count.
@@ -203,9 +209,13 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
             for (int p = 0; p < n_points; ++p) {
                 if (local_failed) continue;
                 const double *x = &X[3 * (size_t)p];
-                int found = sem_raycast_closest_parts(scene, x, radius, parts, dist, points);
+                /* a sample lies on its own part, so only parts through it matter (see
+                 * the header): a tiny query radius, far cheaper than alpha */
+                const int own = own_part ? own_part[p] : -1;
+                const double query = own >= 0 ? s->on_surface : radius;
+                int found = sem_raycast_closest_parts(scene, x, query, parts, dist, points);
                 int fallback_only = 0;
-                if (found <= 0) {
+                if (found <= 0 && own < 0) {
                     /* nothing within the radius: keep only the nearest part, for the
                      * "every theta is zero" rule */
                     found = sem_raycast_closest_parts(scene, x, covering_radius(s, x), parts, dist,
@@ -225,7 +235,6 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
                     found = 1;
                 }
                 /* a sample's own part is always a candidate with theta 1 */
-                int own = own_part ? own_part[p] : -1;
                 int have_own = 0;
                 for (int k = 0; k < found; ++k) have_own |= parts[k] == own;
                 int total = found + (own >= 0 && own < n_parts && !have_own);
@@ -453,12 +462,32 @@ static sem_status build_matrix(const weight_candidates *c, int n_parts, double a
     }
     W->row_start[0] = 0;
     for (int p = 0; p < n; ++p) W->row_start[p + 1] = W->row_start[p] + length[p];
-#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
-    for (int p = 0; p < n; ++p) {
-        int at = W->row_start[p];
-        evaluate_row(c, p, alpha, threshold, &W->col[at], &W->val[at]);
+    /* evaluate_row uses room for every candidate before dropping small weights, so rows
+     * are evaluated in scratch and copied */
+#pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1)
+    {
+        int *cols = malloc((size_t)most * sizeof *cols);
+        double *vals = malloc((size_t)most * sizeof *vals);
+        if (!cols || !vals) {
+#pragma omp atomic write
+            failed = 1;
+        }
+#pragma omp for schedule(static)
+        for (int p = 0; p < n; ++p) {
+            if (!cols || !vals) continue;
+            const int at = W->row_start[p];
+            const int m = evaluate_row(c, p, alpha, threshold, cols, vals);
+            memcpy(&W->col[at], cols, (size_t)m * sizeof *cols);
+            memcpy(&W->val[at], vals, (size_t)m * sizeof *vals);
+        }
+        free(cols);
+        free(vals);
     }
     free(length);
+    if (failed) {
+        sem_csr_free(W);
+        return SEM_ERR_NOMEM;
+    }
     return SEM_OK;
 }
 
@@ -523,43 +552,78 @@ sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const
     return blend_weights(scene, n_points, X, NULL, alpha, threshold, thread_count(0), W, err);
 }
 
-/* alpha whose non-zero fraction is closest to the target T (bisection, see the header). */
+/* Fraction of non-zero weights at cut-off alpha, or -1 when out of memory. */
+static double nonzero_fraction(const weight_candidates *c, int n_parts, double alpha,
+                               double threshold, int n_threads)
+{
+    if (c->n_points == 0) return 0.0;
+    long long nnz = count_nonzeros(c, alpha, threshold, n_threads);
+    return nnz < 0 ? -1.0 : (double)nnz / ((double)c->n_points * (double)n_parts);
+}
+
+/* alpha whose non-zero fraction is closest to the target T (bisection, see the header).
+ * The closest-point queries dominate and grow with the radius, so the smallest radius in
+ * {1/4, 1/2, 1} x diagonal that reaches T is first found on a subsample of at most 256
+ * points; all points are then gathered once at that radius (doubling again if the full
+ * set falls short) and the bisection only re-evaluates Eq. 8-9. The candidates are handed
+ * back in *c, valid for any alpha up to the radius, so W is built without a new gather. */
 static sem_status alpha_from_sparsity(const sem_raycast_scene *scene, const scene_scale *s,
                                       const sem_discretization *d, double target,
                                       double threshold, int n_threads, double *alpha_out,
-                                      sem_error *err)
+                                      weight_candidates *c, sem_error *err)
 {
-    const double cells = (double)d->n_quad * (double)d->n_parts;
+    const int n_parts = d->n_parts;
     const double tolerance = 0.01 * target;
-    weight_candidates c;
-    double radius = 0.25 * s->diagonal, f_hi = 0.0;
+    double radius = 0.25 * s->diagonal, f_hi;
+
+    const int stride = d->n_quad > 256 ? (d->n_quad + 255) / 256 : 1;
+    if (stride > 1) {
+        const int n_sub = (d->n_quad + stride - 1) / stride;
+        double *sub = malloc(3 * (size_t)n_sub * sizeof *sub);
+        if (!sub) return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
+        for (int k = 0; k < n_sub; ++k)
+            memcpy(&sub[3 * (size_t)k], &d->quad_X[3 * (size_t)k * stride], 3 * sizeof *sub);
+        for (;;) {
+            if (gather_candidates(scene, s, n_sub, sub, NULL, radius, n_threads, c) != SEM_OK) {
+                free(sub);
+                return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
+            }
+            f_hi = nonzero_fraction(c, n_parts, radius, threshold, n_threads);
+            candidates_free(c);
+            if (f_hi < 0.0) {
+                free(sub);
+                return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
+            }
+            if (f_hi >= target || radius >= s->diagonal) break;
+            radius = fmin(2.0 * radius, s->diagonal);
+        }
+        free(sub);
+    }
     for (;;) {
-        if (gather_candidates(scene, s, d->n_quad, d->quad_X, NULL, radius, n_threads, &c) !=
-            SEM_OK)
+        if (gather_candidates(scene, s, d->n_quad, d->quad_X, NULL, radius, n_threads, c) != SEM_OK)
             return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
-        long long nnz = count_nonzeros(&c, radius, threshold, n_threads);
-        if (nnz < 0) {
-            candidates_free(&c);
+        f_hi = nonzero_fraction(c, n_parts, radius, threshold, n_threads);
+        if (f_hi < 0.0) {
+            candidates_free(c);
             return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
         }
-        f_hi = (double)nnz / cells;
-        /* alpha beyond the diagonal changes nothing: every distance is shorter */
+        /* alpha beyond the diagonal changes nothing: every distance is shorter; a target
+         * that is not reached there gets the largest fraction the model allows */
         if (f_hi >= target || radius >= s->diagonal) break;
-        candidates_free(&c);
+        candidates_free(c);
         radius = fmin(2.0 * radius, s->diagonal);
     }
     double best_alpha = radius, best_gap = fabs(f_hi - target);
     double lo = 0.0, hi = radius;
     for (int it = 0; it < 30 && best_gap > tolerance && f_hi >= target; ++it) {
-        double mid = 0.5 * (lo + hi);
-        long long nnz = count_nonzeros(&c, mid, threshold, n_threads);
-        if (nnz < 0) {
-            candidates_free(&c);
+        const double mid = 0.5 * (lo + hi);
+        const double f = nonzero_fraction(c, n_parts, mid, threshold, n_threads);
+        if (f < 0.0) {
+            candidates_free(c);
             return sem_error_set(err, SEM_ERR_NOMEM, "weights: out of memory");
         }
-        double f = (double)nnz / cells, gap = fabs(f - target);
-        if (gap < best_gap) {
-            best_gap = gap;
+        if (fabs(f - target) < best_gap) {
+            best_gap = fabs(f - target);
             best_alpha = mid;
         }
         if (f < target)
@@ -567,7 +631,6 @@ static sem_status alpha_from_sparsity(const sem_raycast_scene *scene, const scen
         else
             hi = mid;
     }
-    candidates_free(&c);
     *alpha_out = best_alpha;
     return SEM_OK;
 }
@@ -606,21 +669,32 @@ sem_status sem_step_weights(const sem_model *model, const sem_raycast_scene *sce
     const int n_threads = thread_count(o->threads);
     scene_scale s = scene_scale_of(scene);
     double alpha = 0.0;
+    weight_candidates c;
+    memset(&c, 0, sizeof c);
     if (o->alpha > 0.0) {
         alpha = o->alpha;
     } else if (o->sparsity > 0.0 && d->n_quad > 0) {
         st = alpha_from_sparsity(scene, &s, d, o->sparsity, o->weight_threshold, n_threads, &alpha,
-                                 err);
+                                 &c, err);
         if (st != SEM_OK) return st;
+        if (!(alpha > 0.0)) { /* bisection collapsed on alpha -> 0 */
+            candidates_free(&c);
+            alpha = 0.5 * s.diagonal;
+        }
     } else {
         alpha = 0.5 * s.diagonal;
     }
-    if (!(alpha > 0.0)) alpha = 0.5 * s.diagonal; /* bisection collapsed on alpha -> 0 */
 
     sem_csr_free(&d->W);
     sem_csr_free(&d->W_samples);
-    st = blend_weights(scene, d->n_quad, d->quad_X, NULL, alpha, o->weight_threshold, n_threads,
-                       &d->W, err);
+    if (c.start) { /* candidates of the sparsity search cover alpha: no new gather */
+        st = build_matrix(&c, n_parts, alpha, o->weight_threshold, n_threads, &d->W);
+        candidates_free(&c);
+        if (st != SEM_OK) st = sem_error_set(err, st, "weights: out of memory");
+    } else {
+        st = blend_weights(scene, d->n_quad, d->quad_X, NULL, alpha, o->weight_threshold,
+                           n_threads, &d->W, err);
+    }
     if (st == SEM_OK)
         st = blend_weights(scene, d->n_samples, d->sample_X, d->sample_part, alpha,
                            o->weight_threshold, n_threads, &d->W_samples, err);
