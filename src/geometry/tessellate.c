@@ -81,83 +81,75 @@ static double *samples(int degree, int n_ctrl, const double *knots, double t0, d
     return t;
 }
 
-/* Capacity of the triangle array while parts are added. */
-typedef struct growing {
-    size_t triangle_cap;
-} growing;
+/* One part's topology, built independently of the other parts (so parts are tessellated
+ * in parallel) and then placed at its offsets in the shared arrays. */
+typedef struct part_topology {
+    int nu, nv;
+    double *us, *vs;      /* sample values */
+    int n_vertices, n_triangles;
+    int *node;            /* nu x nv: (i,j) -> local vertex number, -1 while unused */
+    int *triangles;       /* 3 local vertex numbers per triangle */
+    int *vertex_node;     /* n_vertices: node (i + nu j) of each local vertex */
+    sem_status status;
+    sem_error err;
+} part_topology;
 
-static int grow_exact(void **p, size_t n, size_t elem)
+static void part_topology_free(part_topology *pt)
 {
-    void *q = realloc(*p, (n ? n : 1) * elem);
-    if (!q) return 0;
-    *p = q;
-    return 1;
+    free(pt->us);
+    free(pt->vs);
+    free(pt->node);
+    free(pt->triangles);
+    free(pt->vertex_node);
+    memset(pt, 0, sizeof *pt);
 }
 
-static int reserve(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    size_t nc = *cap ? *cap : 1024;
-    while (nc < need) nc *= 2;
-    void *q = realloc(*p, nc * elem);
-    if (!q) return 0;
-    *p = q;
-    *cap = nc;
-    return 1;
-}
-
-static sem_status add_part(sem_mesh_template *t, growing *g, int part_index, const sem_part *part,
-                           int resolution, sem_error *err)
+/* Samples and kept triangles of one part. The triangle and vertex numbering (cells in
+ * row-major order, vertices numbered when first used) is the same for any thread count. */
+static void part_topology_build(const sem_part *part, int part_index, int resolution,
+                                part_topology *pt)
 {
     const sem_surface *s = &part->surface;
-    part_template *pt = &t->parts[part_index];
-    pt->first_vertex = t->n_vertices;
-    pt->first_triangle = t->n_triangles;
-    pt->degree_u = s->degree_u;
-    pt->degree_v = s->degree_v;
-    pt->n_u = s->n_u;
-    pt->n_v = s->n_v;
-    pt->n_basis = (s->degree_u + 1) * (s->degree_v + 1);
-    pt->basis_offset = part_index == 0
-                           ? 0
-                           : t->parts[part_index - 1].basis_offset +
-                                 (size_t)t->parts[part_index - 1].n_vertices *
-                                     (size_t)t->parts[part_index - 1].n_basis;
-
-    int nu = 0, nv = 0;
-    double *us = samples(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1, resolution, &nu);
-    double *vs = samples(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1, resolution, &nv);
-    int *node = NULL;
+    sem_error *err = &pt->err;
     sem_trim_region *region = NULL;
-    sem_status st = SEM_OK;
-    if (!us || !vs) {
-        st = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory (part %d)", part_index);
-        goto done;
+    pt->status = SEM_OK;
+    pt->us = samples(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1, resolution, &pt->nu);
+    pt->vs = samples(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1, resolution, &pt->nv);
+    int nu = pt->nu, nv = pt->nv;
+    if (!pt->us || !pt->vs) {
+        pt->status = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory (part %d)",
+                                   part_index);
+        return;
     }
     if ((double)nu * (double)nv > (double)(INT_MAX / 8)) {
-        st = sem_error_set(err, SEM_ERR_INVALID,
-                           "tessellation: part %d '%s' would need %d x %d samples; lower the "
-                           "resolution",
-                           part_index, part->name, nu, nv);
-        goto done;
+        pt->status = sem_error_set(err, SEM_ERR_INVALID,
+                                   "tessellation: part %d '%s' would need %d x %d samples; lower "
+                                   "the resolution",
+                                   part_index, part->name, nu, nv);
+        return;
     }
     int trimmed = part->has_outer || part->n_holes > 0;
     if (trimmed) {
         sem_error terr;
         if (sem_trim_region_build(part, &region, &terr) != SEM_OK) {
-            st = sem_error_set(err, terr.status, "tessellation: part %d '%s': %s", part_index,
-                               part->name, terr.message);
-            goto done;
+            pt->status = sem_error_set(err, terr.status, "tessellation: part %d '%s': %s",
+                                       part_index, part->name, terr.message);
+            return;
         }
     }
-    /* node (i,j) -> vertex number, -1 while unused */
-    node = malloc((size_t)nu * (size_t)nv * sizeof *node);
-    if (!node) {
-        st = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory (part %d)", part_index);
-        goto done;
+    size_t n_nodes = (size_t)nu * (size_t)nv;
+    size_t max_tri = 2 * (size_t)(nu - 1) * (size_t)(nv - 1);
+    pt->node = malloc(n_nodes * sizeof *pt->node);
+    pt->triangles = malloc((3 * max_tri + 1) * sizeof *pt->triangles);
+    pt->vertex_node = malloc((n_nodes + 1) * sizeof *pt->vertex_node);
+    if (!pt->node || !pt->triangles || !pt->vertex_node) {
+        sem_trim_region_destroy(region);
+        pt->status = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory (part %d)",
+                                   part_index);
+        return;
     }
-    for (size_t k = 0; k < (size_t)nu * (size_t)nv; ++k) node[k] = -1;
-
+    for (size_t k = 0; k < n_nodes; ++k) pt->node[k] = -1;
+    int n_tri = 0, n_vert = 0;
     for (int j = 0; j + 1 < nv; ++j) {
         for (int i = 0; i + 1 < nu; ++i) {
             /* cell corners a=(i,j) b=(i+1,j) c=(i+1,j+1) d=(i,j+1); triangles abc, acd */
@@ -167,72 +159,264 @@ static sem_status add_part(sem_mesh_template *t, growing *g, int part_index, con
                 if (region) {
                     double cu = 0, cv = 0;
                     for (int k = 0; k < 3; ++k) {
-                        cu += us[tri[h][k] % nu];
-                        cv += vs[tri[h][k] / nu];
+                        cu += pt->us[tri[h][k] % nu];
+                        cv += pt->vs[tri[h][k] / nu];
                     }
                     if (!sem_trim_region_inside(region, cu / 3.0, cv / 3.0)) continue;
                 }
-                if (t->n_triangles >= INT_MAX / 4 ||
-                    !reserve((void **)&t->triangles, &g->triangle_cap,
-                             3 * ((size_t)t->n_triangles + 1), sizeof(int))) {
-                    st = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
-                    goto done;
-                }
                 for (int k = 0; k < 3; ++k) {
                     int n = tri[h][k];
-                    if (node[n] < 0) node[n] = t->n_vertices + pt->n_vertices++;
-                    t->triangles[3 * (size_t)t->n_triangles + (size_t)k] = node[n];
+                    if (pt->node[n] < 0) {
+                        pt->node[n] = n_vert;
+                        pt->vertex_node[n_vert++] = n;
+                    }
+                    pt->triangles[3 * (size_t)n_tri + (size_t)k] = pt->node[n];
                 }
-                t->n_triangles++;
-                pt->n_triangles++;
+                n_tri++;
             }
         }
     }
-
-    /* vertex (u,v) and basis rows: the arrays grow once per part, to the exact size */
-    size_t nvert = (size_t)t->n_vertices + (size_t)pt->n_vertices;
-    size_t nbasis = pt->basis_offset + (size_t)pt->n_vertices * (size_t)pt->n_basis;
-    int ok = grow_exact((void **)&t->uv, 2 * nvert, sizeof(double)) &&
-             grow_exact((void **)&t->vertex_part, nvert, sizeof(int)) &&
-             grow_exact((void **)&t->basis_index, nbasis, sizeof(int)) &&
-             grow_exact((void **)&t->phi, nbasis, sizeof(double)) &&
-             grow_exact((void **)&t->phi_u, nbasis, sizeof(double)) &&
-             grow_exact((void **)&t->phi_v, nbasis, sizeof(double));
-    if (!ok) {
-        st = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
-        goto done;
-    }
-    for (int j = 0; j < nv; ++j) {
-        for (int i = 0; i < nu; ++i) {
-            int vtx = node[i + nu * j];
-            if (vtx < 0) continue;
-            t->uv[2 * (size_t)vtx] = us[i];
-            t->uv[2 * (size_t)vtx + 1] = vs[j];
-            t->vertex_part[vtx] = part_index;
-        }
-    }
-    int first = t->n_vertices, count = pt->n_vertices;
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < count; ++k) {
-        size_t off = pt->basis_offset + (size_t)k * (size_t)pt->n_basis;
-        int vtx = first + k;
-        sem_surface_basis(s, t->uv[2 * (size_t)vtx], t->uv[2 * (size_t)vtx + 1],
-                          t->basis_index + off, t->phi + off, t->phi_u + off, t->phi_v + off);
-    }
-    t->n_vertices += pt->n_vertices;
-
-done:
     sem_trim_region_destroy(region);
-    free(node);
-    free(us);
-    free(vs);
-    return st;
+    pt->n_vertices = n_vert;
+    pt->n_triangles = n_tri;
 }
 
-sem_status sem_mesh_template_build(const sem_model *model, int resolution,
-                                   sem_mesh_template **out, sem_error *err)
+/* Non-rational basis values and first derivatives at every sample of one direction, so a
+ * vertex costs no basis evaluation: the same numbers sem_surface_basis computes. */
+typedef struct direction_basis {
+    int *span;
+    double *N; /* 2 (degree + 1) per sample: values, then derivatives */
+} direction_basis;
+
+static int direction_basis_build(int degree, int n_ctrl, const double *knots, const double *t,
+                                 int n, direction_basis *b)
 {
-    *out = NULL;
+    b->span = malloc((size_t)n * sizeof *b->span);
+    b->N = malloc((size_t)n * 2 * (size_t)(degree + 1) * sizeof *b->N);
+    if (!b->span || !b->N) return 0;
+    for (int i = 0; i < n; ++i) {
+        b->span[i] = sem_bspline_span(degree, n_ctrl, knots, t[i]);
+        sem_bspline_basis(degree, knots, b->span[i], t[i], 1,
+                          b->N + (size_t)i * 2 * (size_t)(degree + 1));
+    }
+    return 1;
+}
+
+static void direction_basis_free(direction_basis *b)
+{
+    free(b->span);
+    free(b->N);
+}
+
+/* The rational basis row of sem_surface_basis (same arithmetic, same order, so the
+ * results are bitwise equal) from cached non-rational values. */
+static int basis_row(const sem_surface *s, int su, const double *Nu, int sv, const double *Nv,
+                     int *index, double *phi, double *phi_u, double *phi_v)
+{
+    const int pu = s->degree_u, pv = s->degree_v;
+    double W = 0, Wu = 0, Wv = 0;
+    int n = 0;
+    for (int l = 0; l <= pv; ++l) {
+        int j = sv - pv + l;
+        for (int k = 0; k <= pu; ++k) {
+            int i = su - pu + k;
+            int idx = i + s->n_u * j;
+            double w = s->weights[idx];
+            double b = w * Nu[k] * Nv[l];
+            index[n] = idx;
+            phi[n] = b;
+            W += b;
+            double bu = w * Nu[(pu + 1) + k] * Nv[l];
+            double bv = w * Nu[k] * Nv[(pv + 1) + l];
+            phi_u[n] = bu;
+            phi_v[n] = bv;
+            Wu += bu;
+            Wv += bv;
+            ++n;
+        }
+    }
+    for (int k = 0; k < n; ++k) {
+        double b = phi[k];
+        phi[k] = b / W;
+        phi_u[k] = (phi_u[k] - phi[k] * Wu) / W;
+        phi_v[k] = (phi_v[k] - phi[k] * Wv) / W;
+    }
+    return n;
+}
+
+/* Position and unit normal from a basis row (the per-frame update's arithmetic). */
+static void vertex_frame(const sem_surface *s, int n_basis, const int *index, const double *phi,
+                         const double *phi_u, const double *phi_v, double u, double v,
+                         double *position, double *normal)
+{
+    double x[3] = {0, 0, 0}, xu[3] = {0, 0, 0}, xv[3] = {0, 0, 0};
+    for (int k = 0; k < n_basis; ++k) {
+        const double *P = s->ctrl + 3 * (size_t)index[k];
+        double f = phi[k], fu = phi_u[k], fv = phi_v[k];
+        for (int d = 0; d < 3; ++d) {
+            x[d] += f * P[d];
+            xu[d] += fu * P[d];
+            xv[d] += fv * P[d];
+        }
+    }
+    double nrm[3] = {xu[1] * xv[2] - xu[2] * xv[1], xu[2] * xv[0] - xu[0] * xv[2],
+                     xu[0] * xv[1] - xu[1] * xv[0]};
+    double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    /* Degenerate when |x_u x x_v| is tiny against the larger tangent squared: at a
+     * collapsed edge one tangent is rounding noise (its basis derivatives sum to ~1e-16,
+     * not 0), so a test relative to |x_u||x_v| would accept a noise normal. */
+    double su = xu[0] * xu[0] + xu[1] * xu[1] + xu[2] * xu[2];
+    double sv = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
+    if (len > 1e-10 * fmax(su, sv) && len > 0.0) {
+        for (int d = 0; d < 3; ++d) nrm[d] /= len;
+    } else {
+        sem_surface_normal(s, u, v, nrm);
+    }
+    for (int d = 0; d < 3; ++d) {
+        position[d] = x[d];
+        normal[d] = nrm[d];
+    }
+}
+
+/* Topology of every part, in parallel over parts; first error in part order. */
+static sem_status build_topologies(const sem_model *model, int resolution, part_topology **out,
+                                   sem_error *err)
+{
+    int n_parts = model->n_parts;
+    part_topology *tp = calloc((size_t)(n_parts > 0 ? n_parts : 1), sizeof *tp);
+    if (!tp) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+#pragma omp parallel for schedule(dynamic, 1) if (n_parts > 1)
+    for (int i = 0; i < n_parts; ++i) part_topology_build(&model->parts[i], i, resolution, &tp[i]);
+    for (int i = 0; i < n_parts; ++i)
+        if (tp[i].status != SEM_OK) {
+            if (err) *err = tp[i].err;
+            sem_status st = tp[i].status;
+            for (int k = 0; k < n_parts; ++k) part_topology_free(&tp[k]);
+            free(tp);
+            return st;
+        }
+    *out = tp;
+    return SEM_OK;
+}
+
+static void free_topologies(part_topology *tp, int n_parts)
+{
+    if (!tp) return;
+    for (int k = 0; k < n_parts; ++k) part_topology_free(&tp[k]);
+    free(tp);
+}
+
+/* Shared arrays from the part topologies: offsets, uv, vertex_part, triangles. */
+static sem_status place_topologies(sem_mesh_template *t, const sem_model *model,
+                                   const part_topology *tp, sem_error *err)
+{
+    size_t nvert = 0, ntri = 0, nbasis = 0;
+    for (int i = 0; i < t->n_parts; ++i) {
+        const sem_surface *s = &model->parts[i].surface;
+        part_template *pt = &t->parts[i];
+        pt->first_vertex = (int)nvert;
+        pt->first_triangle = (int)ntri;
+        pt->n_vertices = tp[i].n_vertices;
+        pt->n_triangles = tp[i].n_triangles;
+        pt->degree_u = s->degree_u;
+        pt->degree_v = s->degree_v;
+        pt->n_u = s->n_u;
+        pt->n_v = s->n_v;
+        pt->n_basis = (s->degree_u + 1) * (s->degree_v + 1);
+        pt->basis_offset = nbasis;
+        nvert += (size_t)tp[i].n_vertices;
+        ntri += (size_t)tp[i].n_triangles;
+        nbasis += (size_t)tp[i].n_vertices * (size_t)pt->n_basis;
+        if (nvert > (size_t)INT_MAX / 4 || ntri > (size_t)INT_MAX / 4)
+            return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+    }
+    t->n_vertices = (int)nvert;
+    t->n_triangles = (int)ntri;
+    t->uv = malloc((2 * nvert + 1) * sizeof *t->uv);
+    t->vertex_part = malloc((nvert + 1) * sizeof *t->vertex_part);
+    t->triangles = malloc((3 * ntri + 1) * sizeof *t->triangles);
+    t->triangle_part = malloc((ntri + 1) * sizeof *t->triangle_part);
+    if (!t->uv || !t->vertex_part || !t->triangles || !t->triangle_part)
+        return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+    for (int i = 0; i < t->n_parts; ++i) {
+        const part_template *pt = &t->parts[i];
+        const part_topology *p = &tp[i];
+        for (int k = 0; k < p->n_vertices; ++k) {
+            int n = p->vertex_node[k];
+            size_t vtx = (size_t)pt->first_vertex + (size_t)k;
+            t->uv[2 * vtx] = p->us[n % p->nu];
+            t->uv[2 * vtx + 1] = p->vs[n / p->nu];
+            t->vertex_part[vtx] = i;
+        }
+        for (int k = 0; k < 3 * p->n_triangles; ++k)
+            t->triangles[3 * (size_t)pt->first_triangle + (size_t)k] =
+                pt->first_vertex + p->triangles[k];
+        for (int k = 0; k < p->n_triangles; ++k)
+            t->triangle_part[(size_t)pt->first_triangle + (size_t)k] = i;
+    }
+    return SEM_OK;
+}
+
+/* Basis rows (template) or positions and normals (mesh, when m != NULL) of one part's
+ * vertices, with the direction bases cached per sample column and row. Returns 0 when
+ * out of memory. */
+static int evaluate_part(const sem_mesh_template *t, const sem_model *model, int i,
+                         const part_topology *p, sem_mesh *m)
+{
+    const sem_surface *s = &model->parts[i].surface;
+    const part_template *pt = &t->parts[i];
+    if (p->n_vertices == 0) return 1;
+    direction_basis bu, bv;
+    memset(&bu, 0, sizeof bu);
+    memset(&bv, 0, sizeof bv);
+    int ok = direction_basis_build(s->degree_u, s->n_u, s->knots_u, p->us, p->nu, &bu) &&
+             direction_basis_build(s->degree_v, s->n_v, s->knots_v, p->vs, p->nv, &bv);
+    int nb = pt->n_basis;
+    int *index = NULL;
+    double *phi = NULL;
+    if (ok && m) {
+        index = malloc((size_t)nb * sizeof *index);
+        phi = malloc(3 * (size_t)nb * sizeof *phi);
+        ok = index && phi;
+    }
+    if (ok) {
+        const int su_len = 2 * (s->degree_u + 1), sv_len = 2 * (s->degree_v + 1);
+        for (int k = 0; k < p->n_vertices; ++k) {
+            int n = p->vertex_node[k], iu = n % p->nu, iv = n / p->nu;
+            const double *Nu = bu.N + (size_t)iu * (size_t)su_len;
+            const double *Nv = bv.N + (size_t)iv * (size_t)sv_len;
+            size_t vtx = (size_t)pt->first_vertex + (size_t)k;
+            if (m) {
+                basis_row(s, bu.span[iu], Nu, bv.span[iv], Nv, index, phi, phi + nb, phi + 2 * nb);
+                vertex_frame(s, nb, index, phi, phi + nb, phi + 2 * nb, p->us[iu], p->vs[iv],
+                             m->positions + 3 * vtx, m->normals + 3 * vtx);
+            } else {
+                size_t off = pt->basis_offset + (size_t)k * (size_t)nb;
+                basis_row(s, bu.span[iu], Nu, bv.span[iv], Nv, t->basis_index + off, t->phi + off,
+                          t->phi_u + off, t->phi_v + off);
+            }
+        }
+    }
+    free(index);
+    free(phi);
+    direction_basis_free(&bu);
+    direction_basis_free(&bv);
+    return ok;
+}
+
+static sem_status evaluate_parts(const sem_mesh_template *t, const sem_model *model,
+                                 const part_topology *tp, sem_mesh *m, sem_error *err)
+{
+    int failed = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (t->n_parts > 1)
+    for (int i = 0; i < t->n_parts; ++i)
+        if (!evaluate_part(t, model, i, &tp[i], m)) failed |= 1;
+    if (failed) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+    return SEM_OK;
+}
+
+static sem_status check_model(const sem_model *model, int resolution, sem_error *err)
+{
     if (!model) return sem_error_set(err, SEM_ERR_INVALID, "tessellation: NULL model");
     if (resolution < 1 || resolution > 4096)
         return sem_error_set(err, SEM_ERR_INVALID, "tessellation: resolution %d out of range 1..4096",
@@ -243,6 +427,17 @@ sem_status sem_mesh_template_build(const sem_model *model, int resolution,
             return sem_error_set(err, SEM_ERR_INVALID, "tessellation: part %d '%s': %.900s", i,
                                  model->parts[i].name, e.message);
     }
+    return SEM_OK;
+}
+
+/* Template topology (and, unless skip_basis, its basis rows); *tp_out keeps the part
+ * topologies when non-NULL. */
+static sem_status template_build(const sem_model *model, int resolution, int skip_basis,
+                                 sem_mesh_template **out, part_topology **tp_out, sem_error *err)
+{
+    *out = NULL;
+    sem_status st = check_model(model, resolution, err);
+    if (st != SEM_OK) return st;
     sem_mesh_template *t = calloc(1, sizeof *t);
     if (!t) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     t->n_parts = model->n_parts;
@@ -251,24 +446,39 @@ sem_status sem_mesh_template_build(const sem_model *model, int resolution,
         sem_mesh_template_destroy(t);
         return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     }
-    growing g = {0};
-    for (int i = 0; i < model->n_parts; ++i) {
-        sem_status st = add_part(t, &g, i, &model->parts[i], resolution, err);
-        if (st != SEM_OK) {
-            sem_mesh_template_destroy(t);
-            return st;
-        }
+    part_topology *tp = NULL;
+    st = build_topologies(model, resolution, &tp, err);
+    if (st == SEM_OK) st = place_topologies(t, model, tp, err);
+    if (st == SEM_OK && !skip_basis) {
+        size_t nbasis = 0;
+        for (int i = 0; i < t->n_parts; ++i)
+            nbasis += (size_t)t->parts[i].n_vertices * (size_t)t->parts[i].n_basis;
+        t->basis_index = malloc((nbasis + 1) * sizeof *t->basis_index);
+        t->phi = malloc((nbasis + 1) * sizeof *t->phi);
+        t->phi_u = malloc((nbasis + 1) * sizeof *t->phi_u);
+        t->phi_v = malloc((nbasis + 1) * sizeof *t->phi_v);
+        if (!t->basis_index || !t->phi || !t->phi_u || !t->phi_v)
+            st = sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+        else
+            st = evaluate_parts(t, model, tp, NULL, err);
     }
-    t->triangle_part = malloc(((size_t)t->n_triangles + 1) * sizeof *t->triangle_part);
-    if (!t->triangle_part) {
+    if (st != SEM_OK) {
+        free_topologies(tp, model->n_parts);
         sem_mesh_template_destroy(t);
-        return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
+        return st;
     }
-    for (int i = 0; i < t->n_parts; ++i)
-        for (int k = 0; k < t->parts[i].n_triangles; ++k)
-            t->triangle_part[t->parts[i].first_triangle + k] = i;
+    if (tp_out)
+        *tp_out = tp;
+    else
+        free_topologies(tp, model->n_parts);
     *out = t;
     return SEM_OK;
+}
+
+sem_status sem_mesh_template_build(const sem_model *model, int resolution,
+                                   sem_mesh_template **out, sem_error *err)
+{
+    return template_build(model, resolution, 0, out, NULL, err);
 }
 
 void sem_mesh_free(sem_mesh *m)
@@ -341,33 +551,9 @@ sem_status sem_mesh_update(const sem_mesh_template *t, const sem_model *model, s
         const part_template *pt = &t->parts[p];
         const sem_surface *s = &model->parts[p].surface;
         size_t off = pt->basis_offset + (size_t)(vtx - pt->first_vertex) * (size_t)pt->n_basis;
-        double x[3] = {0, 0, 0}, xu[3] = {0, 0, 0}, xv[3] = {0, 0, 0};
-        for (int k = 0; k < pt->n_basis; ++k) {
-            const double *P = s->ctrl + 3 * (size_t)t->basis_index[off + k];
-            double f = t->phi[off + k], fu = t->phi_u[off + k], fv = t->phi_v[off + k];
-            for (int d = 0; d < 3; ++d) {
-                x[d] += f * P[d];
-                xu[d] += fu * P[d];
-                xv[d] += fv * P[d];
-            }
-        }
-        double nrm[3] = {xu[1] * xv[2] - xu[2] * xv[1], xu[2] * xv[0] - xu[0] * xv[2],
-                         xu[0] * xv[1] - xu[1] * xv[0]};
-        double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-        /* Degenerate when |x_u x x_v| is tiny against the larger tangent squared: at a
-         * collapsed edge one tangent is rounding noise (its basis derivatives sum to ~1e-16,
-         * not 0), so a test relative to |x_u||x_v| would accept a noise normal. */
-        double su = xu[0] * xu[0] + xu[1] * xu[1] + xu[2] * xu[2];
-        double sv = xv[0] * xv[0] + xv[1] * xv[1] + xv[2] * xv[2];
-        if (len > 1e-10 * fmax(su, sv) && len > 0.0) {
-            for (int d = 0; d < 3; ++d) nrm[d] /= len;
-        } else {
-            sem_surface_normal(s, t->uv[2 * (size_t)vtx], t->uv[2 * (size_t)vtx + 1], nrm);
-        }
-        for (int d = 0; d < 3; ++d) {
-            m->positions[3 * (size_t)vtx + (size_t)d] = x[d];
-            m->normals[3 * (size_t)vtx + (size_t)d] = nrm[d];
-        }
+        vertex_frame(s, pt->n_basis, t->basis_index + off, t->phi + off, t->phi_u + off,
+                     t->phi_v + off, t->uv[2 * (size_t)vtx], t->uv[2 * (size_t)vtx + 1],
+                     m->positions + 3 * (size_t)vtx, m->normals + 3 * (size_t)vtx);
     }
     return SEM_OK;
 }
@@ -375,13 +561,18 @@ sem_status sem_mesh_update(const sem_mesh_template *t, const sem_model *model, s
 sem_status sem_mesh_from_model(const sem_model *model, int resolution, sem_mesh *out,
                                sem_error *err)
 {
+    /* topology only, then positions and normals straight from cached direction bases:
+     * the template's basis rows are never stored (same arithmetic as template + update,
+     * so the result is bitwise the same) */
     memset(out, 0, sizeof *out);
     sem_mesh_template *t;
-    sem_status st = sem_mesh_template_build(model, resolution, &t, err);
+    part_topology *tp = NULL;
+    sem_status st = template_build(model, resolution, 1, &t, &tp, err);
     if (st != SEM_OK) return st;
     st = sem_mesh_template_mesh(t, out, err);
-    if (st == SEM_OK) st = sem_mesh_update(t, model, out, err);
+    if (st == SEM_OK) st = evaluate_parts(t, model, tp, out, err);
     if (st != SEM_OK) sem_mesh_free(out);
+    free_topologies(tp, model->n_parts);
     sem_mesh_template_destroy(t);
     return st;
 }

@@ -74,6 +74,7 @@ typedef struct object {
     double *M_blocks;          /* gpair_offset[n] */
     double *E_blocks;          /* error matrix, gpair_offset[n] */
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
+    int n_orphans;             /* control points tied to their part's polynomial (no samples) */
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
     double gamma;
@@ -474,17 +475,129 @@ static sem_status setup_constant_blocks(object *o, sem_error *err)
     }
     free(tmp);
     free(Mz);
-    /* error matrix: scatter the scalar CSR */
-    const sem_csr *E = &o->d->M_eps;
-    for (int r = 0; r < E->n_rows; ++r)
-        for (int e = E->row_start[r]; e < E->row_start[r + 1]; ++e) {
-            int c = E->col[e];
-            int ga = o->ctrl_group[r], gb = o->ctrl_group[c];
-            int g = o->gpair_lookup[(size_t)ga * o->n_groups + gb];
-            size_t nb = gsize(o, gb);
-            o->E_blocks[o->gpair_offset[g] + (size_t)o->ctrl_local[r] * nb + (size_t)o->ctrl_local[c]] +=
-                E->val[e];
+    /* Control points that no boundary sample sees (their basis functions are supported
+     * only where a trim removed the surface) appear in no term of the discretization, so
+     * the system would be singular. Each such point is tied to its own part's polynomial
+     * at its rest position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical
+     * control point's error term. It vanishes for every affine motion (the control points
+     * of an affinely mapped NURBS are affinely mapped), so the patch test is unaffected. */
+    {
+        const sem_csr *J = &o->d->J_hat;
+        double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
+        if (!colw) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int r = 0; r < J->n_rows; ++r)
+            for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
+                colw[J->col[e]] += o->d->sample_area[r] * J->val[e] * J->val[e];
+        double mean = 0;
+        for (int c = 0; c < o->n_ctrl; ++c) mean += colw[c];
+        mean /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+        double *row = malloc(mg * sizeof(double) + 1);
+        if (!row) {
+            free(colw);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
+        o->n_orphans = 0;
+        for (int i = 0; i < o->n_parts; ++i) {
+            int g = o->d->part_origin[i];
+            size_t n = gsize(o, g);
+            int gp = o->gpair_lookup[(size_t)g * o->n_groups + g];
+            if (gp < 0) continue;
+            for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
+                if (colw[c] > 1e-10 * mean) continue;
+                const double *X = o->q0 + 3 * (size_t)c, *Xb = o->d->origin_X + 3 * (size_t)g;
+                double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
+                sem_polynomial_basis(o->d->order, dX, b, NULL);
+                for (size_t l = 0; l < n; ++l) {
+                    double v = 0;
+                    for (int k = 0; k < m; ++k) v += b[k] * o->pi_dense[i][(size_t)k * n + l];
+                    row[l] = -v;
+                }
+                row[o->ctrl_local[c]] += 1.0;
+                double *blk = o->E_blocks + o->gpair_offset[gp];
+                for (size_t a = 0; a < n; ++a)
+                    if (row[a] != 0)
+                        for (size_t bb = 0; bb < n; ++bb) blk[a * n + bb] += mean * row[a] * row[bb];
+                o->n_orphans++;
+            }
+        }
+        free(row);
+        free(colw);
+    }
+    /* Error matrix (Eq. 16) as a sum of outer products of r_s = Gamma_s - J_s, so it is
+     * positive semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J
+     * cancels large terms, and its round-off can leave small negative eigenvalues exactly in
+     * the directions the mass matrix does not see (M has rank at most the number of
+     * quadrature points per coordinate), which makes M + h^2 (K + 2 gamma M_eps) indefinite. */
+    {
+        const sem_csr *G = &o->d->Gamma_samples, *J = &o->d->J_hat;
+        int *rc = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+        double *rv = malloc(((size_t)o->n_ctrl + 1) * sizeof(double));
+        if (!rc || !rv) {
+            free(rc);
+            free(rv);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        /* A collapsed edge (a sphere's pole) has a zero area element, so its samples would
+         * drop out, and with them the only information that fixes the control points of the
+         * collapsed row: the system becomes singular. Every sample keeps at least 5% of its
+         * part's mean sample weight. */
+        double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
+        int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
+        if (!part_mean || !part_count) {
+            free(part_mean);
+            free(part_count);
+            free(rc);
+            free(rv);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        for (int r = 0; r < o->d->n_samples; ++r) {
+            part_mean[o->d->sample_part[r]] += o->d->sample_area[r];
+            part_count[o->d->sample_part[r]]++;
+        }
+        for (int i = 0; i < o->n_parts; ++i)
+            if (part_count[i]) part_mean[i] /= part_count[i];
+        for (int r = 0; r < G->n_rows; ++r) {
+            /* merge the sorted rows of Gamma_s and J_s */
+            int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
+            int n = 0;
+            while (a < ae || b < be) {
+                if (b >= be || (a < ae && G->col[a] < J->col[b])) {
+                    rc[n] = G->col[a];
+                    rv[n++] = G->val[a++];
+                } else if (a >= ae || J->col[b] < G->col[a]) {
+                    rc[n] = J->col[b];
+                    rv[n++] = -J->val[b++];
+                } else {
+                    rc[n] = G->col[a];
+                    rv[n++] = G->val[a++] - J->val[b++];
+                }
+            }
+            double area = fmax(o->d->sample_area[r], 0.05 * part_mean[o->d->sample_part[r]]);
+            for (int x = 0; x < n; ++x) {
+                int gx = o->ctrl_group[rc[x]];
+                double ax = area * rv[x];
+                if (ax == 0) continue;
+                for (int y = 0; y < n; ++y) {
+                    int gy = o->ctrl_group[rc[y]];
+                    int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
+                    if (gp < 0) {
+                        free(part_mean);
+                        free(part_count);
+                        free(rc);
+                        free(rv);
+                        return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
+                    }
+                    size_t nb = gsize(o, gy);
+                    o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[rc[x]] * nb + (size_t)o->ctrl_local[rc[y]]] +=
+                        ax * rv[y];
+                }
+            }
+        }
+        free(part_mean);
+        free(part_count);
+        free(rc);
+        free(rv);
+    }
     return SEM_OK;
 }
 

@@ -388,6 +388,9 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
 
     st = sem_step_weights(model, scene, &o, d, err);
     if (st != SEM_OK) goto done;
+    int n_covered = 0;
+    st = sem_cover_unweighted_parts(d, &n_covered, err);
+    if (st != SEM_OK) goto done;
     st = sem_step_origins(model, d, err);
     if (st == SEM_OK) st = sem_merge_degenerate_origins(d, err);
     if (st != SEM_OK) goto done;

@@ -32,6 +32,10 @@ sem_status sem_step_weights(const sem_model *model, const sem_raycast_scene *sce
 sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const double *X,
                              double alpha, double threshold, sem_csr *W, sem_error *err);
 
+/* weights_cover.c: blends every part that has no weight at any quadrature point into the
+ * points nearest to it (rows still sum to one); *n_covered counts such parts. */
+sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem_error *err);
+
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
 /* origins_merge.c: merges every origin whose samples are flat (planar or collinear) into

@@ -185,11 +185,20 @@ static sem_status parse_transform(ctx *c, const cJSON *t, const char *where, dou
     if (m) {
         snprintf(w, sizeof w, "%s.matrix", where);
         if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 3) return fail(c, w, "must be 3 rows of 4 numbers");
+        if (cJSON_GetObjectItemCaseSensitive(t, "scale") || cJSON_GetObjectItemCaseSensitive(t, "rotate") ||
+            cJSON_GetObjectItemCaseSensitive(t, "translate"))
+            return fail(c, w, "give either \"matrix\" or scale/rotate/translate, not both");
         for (int r = 0; r < 3; ++r) {
             char wr[300];
             snprintf(wr, sizeof wr, "%s[%d]", w, r);
             if ((st = vec_n(c, cJSON_GetArrayItem(m, r), wr, 4, T + 4 * r)) != SEM_OK) return st;
         }
+        /* a mirror (det < 0) turns the surfaces inside out; det = 0 flattens the solid */
+        double det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
+                     T[2] * (T[4] * T[9] - T[5] * T[8]);
+        if (!(det > 0))
+            return fail(c, w, "the 3x3 part must have a positive determinant (got %g): mirrors and "
+                        "flattening maps are not allowed", det);
         return SEM_OK;
     }
     const cJSON *s = cJSON_GetObjectItemCaseSensitive(t, "scale");
@@ -353,27 +362,72 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         else
             snprintf(obj->model_path, sizeof obj->model_path, "%s/%s", base_dir, p);
     } else {
-        static const char *const pkeys[] = {"type", "size", "length", "width", "height", "sections",
-                                            "radius", "major", "minor", NULL};
+        /* each shape takes only its own size keys, so "radius" on a box is an error, not a
+         * silently ignored setting */
+        static const char *const box_keys[] = {"type", "size", NULL};
+        static const char *const beam_keys[] = {"type", "size", "length", "width", "height", "sections", NULL};
+        static const char *const sphere_keys[] = {"type", "radius", NULL};
+        static const char *const cylinder_keys[] = {"type", "radius", "height", NULL};
+        static const char *const torus_keys[] = {"type", "major", "minor", NULL};
         snprintf(w, sizeof w, "%s.primitive", where);
-        if ((st = check_keys(c, prim, w, pkeys)) != SEM_OK) return st;
+        if (!cJSON_IsObject(prim)) return fail(c, w, "must be a JSON object");
         const cJSON *t = cJSON_GetObjectItemCaseSensitive(prim, "type");
-        if (!cJSON_IsString(t) || (strcmp(t->valuestring, "box") && strcmp(t->valuestring, "beam") &&
-                                   strcmp(t->valuestring, "sphere") && strcmp(t->valuestring, "cylinder") &&
-                                   strcmp(t->valuestring, "torus")))
-            return fail(c, w, "type must be box, beam, sphere, cylinder or torus");
+        const char *const *pkeys = NULL;
+        if (cJSON_IsString(t)) {
+            if (!strcmp(t->valuestring, "box")) pkeys = box_keys;
+            else if (!strcmp(t->valuestring, "beam")) pkeys = beam_keys;
+            else if (!strcmp(t->valuestring, "sphere")) pkeys = sphere_keys;
+            else if (!strcmp(t->valuestring, "cylinder")) pkeys = cylinder_keys;
+            else if (!strcmp(t->valuestring, "torus")) pkeys = torus_keys;
+        }
+        if (!pkeys) {
+            char wt[300];
+            snprintf(wt, sizeof wt, "%s.type", w);
+            return fail(c, wt, "must be \"box\", \"beam\", \"sphere\", \"cylinder\" or \"torus\"");
+        }
+        if ((st = check_keys(c, prim, w, pkeys)) != SEM_OK) return st;
         snprintf(obj->primitive, sizeof obj->primitive, "%s", t->valuestring);
+        /* 0 = not given: the builder's default (sem/primitives.h) */
         obj->primitive_size[0] = obj->primitive_size[1] = obj->primitive_size[2] = 0;
         obj->primitive_sections = 0;
+        int is_torus = !strcmp(obj->primitive, "torus");
         if ((st = get_vec(c, prim, "size", w, 3, obj->primitive_size)) != SEM_OK) return st;
+        for (int k = 0; k < 3; ++k)
+            if (cJSON_GetObjectItemCaseSensitive(prim, "size") && !(obj->primitive_size[k] > 0)) {
+                char wk[300];
+                snprintf(wk, sizeof wk, "%s.size", w);
+                return fail(c, wk, "sizes must be positive (got %g along axis %d)", obj->primitive_size[k], k);
+            }
         if ((st = get_number(c, prim, "length", w, &obj->primitive_size[0])) != SEM_OK) return st;
         if ((st = get_number(c, prim, "width", w, &obj->primitive_size[1])) != SEM_OK) return st;
-        if ((st = get_number(c, prim, "height", w, &obj->primitive_height)) != SEM_OK) return st;
-        obj->primitive_size[2] = obj->primitive_height;
+        if ((st = get_number(c, prim, "height", w, &obj->primitive_size[2])) != SEM_OK) return st;
+        obj->primitive_height = obj->primitive_size[2];
         if ((st = get_int(c, prim, "sections", w, &obj->primitive_sections)) != SEM_OK) return st;
-        if ((st = get_number(c, prim, "radius", w, &obj->primitive_radius)) != SEM_OK) return st;
-        if ((st = get_number(c, prim, "major", w, &obj->primitive_radius)) != SEM_OK) return st;
+        if ((st = get_number(c, prim, is_torus ? "major" : "radius", w, &obj->primitive_radius)) != SEM_OK)
+            return st;
         if ((st = get_number(c, prim, "minor", w, &obj->primitive_radius2)) != SEM_OK) return st;
+        /* every given size must be positive (a missing one keeps its default) */
+        static const char *const positive_keys[] = {"length", "width", "height", "radius", "major", "minor", NULL};
+        for (int k = 0; positive_keys[k]; ++k) {
+            const cJSON *v = cJSON_GetObjectItemCaseSensitive(prim, positive_keys[k]);
+            if (v && !(v->valuedouble > 0)) {
+                char wk[300];
+                snprintf(wk, sizeof wk, "%s.%s", w, positive_keys[k]);
+                return fail(c, wk, "must be positive (got %g)", v->valuedouble);
+            }
+        }
+        const cJSON *sec = cJSON_GetObjectItemCaseSensitive(prim, "sections");
+        if (sec && (obj->primitive_sections < 1 || obj->primitive_sections > 10000)) {
+            char wk[300];
+            snprintf(wk, sizeof wk, "%s.sections", w);
+            return fail(c, wk, "must be in 1..10000 (got %d)", obj->primitive_sections);
+        }
+        if (is_torus) {
+            sem_torus_def td = sem_default_torus_def();
+            double R = obj->primitive_radius > 0 ? obj->primitive_radius : td.major;
+            double r = obj->primitive_radius2 > 0 ? obj->primitive_radius2 : td.minor;
+            if (!(r < R)) return fail(c, w, "minor radius %g must be less than major radius %g", r, R);
+        }
     }
     const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
     if (t) {
@@ -472,11 +526,19 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             double dps = 0, rps = 0;
             if ((st = get_number(c, ro, "degrees_per_second", w2, &dps)) != SEM_OK) return st;
             if ((st = get_number(c, ro, "radians_per_second", w2, &rps)) != SEM_OK) return st;
+            if (cJSON_GetObjectItemCaseSensitive(ro, "degrees_per_second") &&
+                cJSON_GetObjectItemCaseSensitive(ro, "radians_per_second"))
+                return fail(c, w2, "give either \"degrees_per_second\" or \"radians_per_second\", not both");
             obj->prescribe.rate = rps != 0 ? rps : dps * M_PI / 180.0;
             if ((st = get_number(c, ro, "duration", w2, &obj->prescribe.duration)) != SEM_OK) return st;
             const double *a = obj->prescribe.axis_direction;
             if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] > 0)) return fail(c, w2, "axis must not be zero");
         }
+    }
+    if (obj->prescribe.type != SEM_PRESCRIBE_NONE && !obj->has_pin_box && obj->n_pin_parts == 0 &&
+        obj->n_pin_points == 0) {
+        snprintf(w, sizeof w, "%s.prescribe", where);
+        return fail(c, w, "moves the pinned control points, but the object has no \"pin\"");
     }
     if ((st = get_vec(c, o, "initial_velocity", where, 3, obj->initial_velocity)) != SEM_OK) return st;
     if ((st = get_vec(c, o, "initial_angular_velocity", where, 3, obj->initial_angular_velocity)) != SEM_OK)
@@ -593,6 +655,9 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
     if ((st = get_int(c, root, "steps_per_frame", "scene", &s->steps_per_frame)) != SEM_OK) return st;
     if (s->steps_per_frame < 1) return fail(c, "steps_per_frame", "must be >= 1");
     if ((st = get_int(c, root, "threads", "scene", &s->world.threads)) != SEM_OK) return st;
+    if (s->world.threads < 0 || s->world.threads > 4096) return fail(c, "threads", "must be in 0..4096 (0: all cores)");
+    const cJSON *desc = cJSON_GetObjectItemCaseSensitive(root, "description");
+    if (desc && !cJSON_IsString(desc)) return fail(c, "description", "must be a string");
     const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
     if (out) {
         static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "mesh_resolution", NULL};
@@ -705,10 +770,12 @@ sem_status sem_scene_load(const char *path, sem_scene **out, sem_error *err)
     char base[4096];
     snprintf(base, sizeof base, "%s", path);
     char *slash = strrchr(base, '/');
-    if (slash)
+    if (slash == base)
+        base[1] = '\0'; /* scene in "/" */
+    else if (slash)
         *slash = '\0';
     else
-        strcpy(base, ".");
+        base[0] = '\0'; /* scene in the working folder: model paths are used as written */
     sem_status st = sem_scene_parse(buf, path, base, out, err);
     free(buf);
     if (st == SEM_OK) snprintf((*out)->path, sizeof (*out)->path, "%s", path);
@@ -760,7 +827,8 @@ sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model *
     if (o->model_path[0]) {
         st = sem_model_load(o->model_path, &m, err);
         if (st != SEM_OK) {
-            if (err && !strstr(err->message, o->model_path)) {
+            /* always name the key: "scene.json: objects[0].model: dir/x.igs: cannot open: ..." */
+            if (err) {
                 char msg[sizeof err->message];
                 snprintf(msg, sizeof msg, "%s", err->message);
                 sem_error_set(err, st, "%s: objects[%d].model: %s", scene->path[0] ? scene->path : "scene",
@@ -855,6 +923,12 @@ sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, 
     for (size_t c = 0; c < n; ++c) count += pin[c];
     if (count == 0) {
         free(pin);
+        if (o->has_pin_box)
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "pin.box: [[%g, %g, %g], [%g, %g, %g]] contains no control point of the model "
+                                 "(after its transform)",
+                                 o->pin_box[0], o->pin_box[1], o->pin_box[2], o->pin_box[3], o->pin_box[4],
+                                 o->pin_box[5]);
         return sem_error_set(err, SEM_ERR_INVALID, "pin: selects no control point of the model");
     }
     *out = pin;

@@ -1,0 +1,68 @@
+/*
+ * validation.h - helpers shared by the validation studies (bench/study_*.c), `sem bench`
+ * and tests/test_validation.c: the static cantilever of the deflection study (paper Fig. 10),
+ * the recorded FEM reference (validation/fem_cantilever.json, tools/fem/cantilever.py),
+ * the Table 1 rows with the authors' settings and a least-squares fit on log-log axes.
+ *
+ * Not part of the public API (src/ include path only).
+ */
+#ifndef SEM_BENCH_VALIDATION_H
+#define SEM_BENCH_VALIDATION_H
+
+#include "sem/material.h"
+#include "sem/model.h"
+#include "sem/preprocess.h"
+#include "sem/status.h"
+
+/* The deflection study's setup: 5 x 1 x 1 m beam clamped at x = 0 (control points with
+ * x = 0 pinned), gravity along -z, quadratic SEM with the authors' ray settings. */
+typedef struct sem_cantilever_settings {
+    int order;               /* 2 */
+    int rays[2];             /* 3 x 3 */
+    int points_per_interval; /* 100 */
+    double alpha;            /* 0.501 */
+    double gamma;            /* error stiffness; <= 0: the preprocessing default (kappa E / L) */
+    sem_material_type material; /* neo-Hookean (the paper's) */
+    double density, youngs_modulus, poisson_ratio; /* 1000, 1e6, 0.45 */
+    double gravity;          /* 10 m/s^2 along -z */
+    int threads;             /* 0: OpenMP default */
+} sem_cantilever_settings;
+
+sem_cantilever_settings sem_default_cantilever_settings(void);
+
+typedef struct sem_cantilever_result {
+    int parts, dofs, quad_points;
+    double volume;
+    double tip_deflection;   /* mean -u_z of the free end cap's control points, m */
+    int newton_iterations;
+    double preprocess_s, solve_s;
+} sem_cantilever_result;
+
+/* Preprocesses the model with the settings and solves statics. The free end is the part
+ * whose control points all lie at the largest x (the end cap; for a uniform biquadratic
+ * Bezier cap the mean of its control points is exactly its area-weighted mean, since each
+ * degree-2 Bernstein polynomial integrates to 1/3). */
+sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_settings *s,
+                                sem_cantilever_result *out, sem_error *err);
+
+/* Reads "tip_deflection_m" of the FEM reference file written by tools/fem/cantilever.py. */
+sem_status sem_fem_reference_read(const char *path, double *tip_deflection, sem_error *err);
+
+/* Least squares y = c x^p on log-log axes over the points with x, y > 0: returns p, sets
+ * *c (may be NULL). NaN with fewer than 2 usable points. */
+double sem_loglog_fit(const double *x, const double *y, int n, double *c);
+
+/* Table 1 of the paper with the authors' settings (models README) and the paper's figures. */
+typedef struct sem_table1_row {
+    const char *example, *file;
+    double density, youngs_modulus, poisson_ratio;
+    int order, rays[2], points_per_interval;
+    double alpha;            /* 0: the default rule */
+    int paper_q;
+    double paper_sample, paper_quad, paper_weights, paper_build_pi, paper_step, paper_nnz;
+} sem_table1_row;
+
+extern const sem_table1_row sem_table1[];
+extern const int sem_table1_count;
+
+#endif

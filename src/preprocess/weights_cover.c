@@ -1,0 +1,118 @@
+/*
+ * weights_cover.c - every part must carry weight at some quadrature point.
+ *
+ * Why: a thin part (a rocket fin hit by no ray of a coarse grid) can end with no volume
+ * point where its weight is non-zero: the secondary rays of Eq. 8 from its surface
+ * through nearby interior points hit the body first, so theta = 0 everywhere. Its
+ * polynomial then enters neither the mass nor the stiffness, and its control points can
+ * move freely at zero energy: the system matrix is singular and the part would detach
+ * from the body. The paper's Eq. 8-9 leave this case open. We blend such a part into the
+ * quadrature points nearest to its surface: at the K nearest points (distance measured to
+ * its boundary samples) it gets weight w = 0.5 d_min / d (0.5 at the nearest point,
+ * less farther away) and the point's other weights are scaled by (1 - w), so rows still
+ * sum to one. The part then moves with the body around it, as a thin attached feature
+ * should. This runs after the weights and before the origins (which read W).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "steps.h"
+
+#define COVER_POINTS 8
+
+sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem_error *err)
+{
+    *n_covered = 0;
+    int np = d->n_parts, nq = d->n_quad;
+    if (nq == 0 || np == 0) return SEM_OK;
+    unsigned char *seen = calloc((size_t)np, 1);
+    if (!seen) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (size_t e = 0; e < sem_csr_nnz(&d->W); ++e)
+        if (d->W.val[e] > 0) seen[d->W.col[e]] = 1;
+    int missing = 0;
+    for (int i = 0; i < np; ++i) missing += !seen[i];
+    if (missing == 0) {
+        free(seen);
+        return SEM_OK;
+    }
+    /* triplets of the new W */
+    size_t cap = sem_csr_nnz(&d->W) + (size_t)missing * COVER_POINTS;
+    int *rows = malloc((cap + 1) * sizeof(int)), *cols = malloc((cap + 1) * sizeof(int));
+    double *vals = malloc((cap + 1) * sizeof(double));
+    double *scale = malloc((size_t)nq * sizeof(double));
+    double *dist = malloc((size_t)nq * sizeof(double));
+    int *best = malloc(COVER_POINTS * sizeof(int));
+    if (!rows || !cols || !vals || !scale || !dist || !best) {
+        free(rows);
+        free(cols);
+        free(vals);
+        free(scale);
+        free(dist);
+        free(best);
+        free(seen);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int p = 0; p < nq; ++p) scale[p] = 1.0;
+    size_t n = 0;
+    /* new entries first (their rows' other weights are scaled below) */
+    for (int i = 0; i < np; ++i) {
+        if (seen[i]) continue;
+        for (int p = 0; p < nq; ++p) {
+            double dm = INFINITY;
+            const double *X = d->quad_X + 3 * (size_t)p;
+            for (int s = 0; s < d->n_samples; ++s) {
+                if (d->sample_part[s] != i) continue;
+                const double *S = d->sample_X + 3 * (size_t)s;
+                double dd = (X[0] - S[0]) * (X[0] - S[0]) + (X[1] - S[1]) * (X[1] - S[1]) + (X[2] - S[2]) * (X[2] - S[2]);
+                if (dd < dm) dm = dd;
+            }
+            dist[p] = sqrt(dm);
+        }
+        int k = nq < COVER_POINTS ? nq : COVER_POINTS;
+        for (int j = 0; j < k; ++j) {
+            int b = -1;
+            for (int p = 0; p < nq; ++p) {
+                int taken = 0;
+                for (int t = 0; t < j; ++t) taken |= best[t] == p;
+                if (!taken && (b < 0 || dist[p] < dist[b])) b = p;
+            }
+            best[j] = b;
+        }
+        double dmin = dist[best[0]] > 0 ? dist[best[0]] : 1e-300;
+        for (int j = 0; j < k; ++j) {
+            int p = best[j];
+            double w = 0.5 * (dist[p] > 0 ? dmin / dist[p] : 1.0);
+            if (w > 0.5) w = 0.5;
+            w *= scale[p]; /* a point covering several parts shares what is left */
+            scale[p] -= w;
+            rows[n] = p;
+            cols[n] = i;
+            vals[n++] = w;
+        }
+        (*n_covered)++;
+    }
+    for (int p = 0; p < nq; ++p)
+        for (int e = d->W.row_start[p]; e < d->W.row_start[p + 1]; ++e) {
+            rows[n] = p;
+            cols[n] = d->W.col[e];
+            vals[n++] = d->W.val[e] * scale[p];
+        }
+    sem_csr W;
+    sem_status st = sem_csr_from_triplets(&W, nq, np, n, rows, cols, vals);
+    if (st == SEM_OK) {
+        sem_csr_free(&d->W);
+        d->W = W;
+        d->weight_nonzero_fraction = (double)sem_csr_nnz(&W) / ((double)nq * np);
+    } else {
+        sem_error_set(err, st, "out of memory");
+    }
+    free(rows);
+    free(cols);
+    free(vals);
+    free(scale);
+    free(dist);
+    free(best);
+    free(seen);
+    return st;
+}
