@@ -108,9 +108,13 @@ static const row table1[] = {
 
 static void test_table1_runs(void)
 {
-    int steps = getenv("SEM_SANITIZED") ? 5 : 100;
+    /* Under the sanitizers (10-50x slower) a subset runs a few steps: the full set runs
+     * in the Release pass of the same CI. */
+    int sanitized = getenv("SEM_SANITIZED") != NULL;
+    int steps = sanitized ? 3 : 100;
     for (size_t k = 0; k < sizeof table1 / sizeof table1[0]; ++k) {
         const row *r = &table1[k];
+        if (sanitized && k != 1 && k != 3) continue;
         const char *path = test_shared_model(r->file);
         if (!path) continue;
         sem_error err;

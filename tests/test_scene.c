@@ -96,6 +96,7 @@ static void test_errors(void)
     expect_error(BOX ", \"sem\": {\"sparsity\": 0}", "", "objects[0].sem.sparsity", "(0, 1)");
     expect_error(BOX ", \"sem\": {\"sparsity\": 1}", "", "objects[0].sem.sparsity", "(0, 1)");
     expect_error(BOX ", \"sem\": {\"order\": 3}", "", "objects[0].sem.order", "1 or 2");
+    expect_error(BOX ", \"sem\": {\"alpha\": 1, \"sparsity\": 0.5}", "", "objects[0].sem: give either", "not both");
     expect_error(BOX ", \"sem\": {\"rays\": [0, 4]}", "", "objects[0].sem.rays", NULL);
     expect_error(BOX ", \"sem\": {\"ray_axis\": \"w\"}", "", "objects[0].sem.ray_axis", NULL);
     /* primitives, transforms, pins, prescriptions, loads */

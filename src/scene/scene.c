@@ -272,6 +272,8 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
             return fail(c, w, "must be in (0, 1) (got %g)", o->sparsity);
         }
     }
+    if (a && !cJSON_IsNull(a) && sp && !cJSON_IsNull(sp))
+        return fail(c, where, "give either \"alpha\" or \"sparsity\", not both");
     const cJSON *r = cJSON_GetObjectItemCaseSensitive(s, "rays");
     if (r) {
         double rr[2];

@@ -1,0 +1,220 @@
+/*
+ * cmd_bench.c - `sem bench [--json] [--models DIR] [--steps N] [--only TEXT]`: the paper's
+ * Table 1 on the shared models, beside the paper's figures (MATLAB + C++ MEX on a 2.3 GHz
+ * i5 laptop) with the speed-up paper / ours per column.
+ *
+ * Each row uses the paper's material and order and the authors' ray settings (models
+ * README; table in src/bench/validation.c). Columns: dofs; the preprocessing phases of
+ * sem_preprocess (sample, quad, weights, build Pi); step = mean wall time of `--steps`
+ * linearly implicit Euler steps (gravity 9.8 m/s^2 along -z, dt 0.01, no collision), after
+ * one untimed warm-up step that does the one-off work (solver choice, symbolic analysis);
+ * factor = mean time of the one factorization inside those steps
+ * (sem_world_last_factor_seconds); Nnz% of the q-space system matrix.
+ *
+ * Rows whose file is missing are skipped (with a warning). Progress goes to stderr.
+ * Exit status: 0 when every available row ran; 1 when one failed or none was found.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "bench/validation.h"
+#include "cli.h"
+#include "sem/preprocess.h"
+#include "sem/simulation.h"
+
+#define CMD "bench"
+
+typedef struct bench_result {
+    int dofs;
+    double sample_s, quad_s, weights_s, build_pi_s, step_s, factor_s, nnz_percent;
+    const char *solver;
+} bench_result;
+
+static int is_dir(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+static const char *default_models_dir(void)
+{
+    const char *env = getenv("SEM_SHARED_MODELS");
+    if (env && is_dir(env)) return env;
+    if (is_dir("../shared/models")) return "../shared/models";
+    if (is_dir("../../shared/models")) return "../../shared/models";
+    return NULL;
+}
+
+static sem_status run_row(const sem_table1_row *r, const char *path, int steps, bench_result *out,
+                          sem_error *err)
+{
+    sem_model *m = NULL;
+    sem_status st = sem_model_load(path, &m, err);
+    if (st != SEM_OK) return st;
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.order = r->order;
+    po.rays[0] = r->rays[0];
+    po.rays[1] = r->rays[1];
+    po.points_per_interval = r->points_per_interval;
+    po.alpha = r->alpha;
+    po.youngs_modulus = r->youngs_modulus;
+    sem_discretization *d = NULL;
+    sem_world *w = NULL;
+    st = sem_preprocess(m, &po, &d, err);
+    if (st != SEM_OK) goto done;
+    out->dofs = 3 * d->n_ctrl;
+    out->sample_s = d->timings.sample_s;
+    out->quad_s = d->timings.quad_s;
+    out->weights_s = d->timings.weights_s;
+    out->build_pi_s = d->timings.build_pi_s;
+
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.8;
+    wd.dt = 0.01;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    w = sem_world_create(&wd, err);
+    if (!w) {
+        st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
+        goto done;
+    }
+    sem_object_def od = sem_default_object_def();
+    od.model = m;
+    od.disc = d;
+    od.material.density = r->density;
+    od.material.youngs_modulus = r->youngs_modulus;
+    od.material.poisson_ratio = r->poisson_ratio;
+    if (sem_world_add_object(w, &od, err) < 0) {
+        st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
+        goto done;
+    }
+    st = sem_world_step(w, err); /* warm-up */
+    double ts = 0, tf = 0;
+    for (int s = 0; s < steps && st == SEM_OK; ++s) {
+        st = sem_world_step(w, err);
+        ts += sem_world_last_step_seconds(w);
+        tf += sem_world_last_factor_seconds(w);
+    }
+    if (st != SEM_OK) goto done;
+    out->step_s = ts / steps;
+    out->factor_s = tf / steps;
+    out->nnz_percent = sem_world_object_nnz_percent(w, 0);
+    out->solver = sem_world_solver_name(w, 0);
+done:
+    sem_world_destroy(w);
+    sem_discretization_destroy(d);
+    sem_model_destroy(m);
+    return st;
+}
+
+static void print_cell(double ours, double paper)
+{
+    printf(" %8.2e %8.2e %6.1fx |", ours, paper, paper / ours);
+}
+
+int cmd_bench(int argc, char **argv)
+{
+    int json = 0, steps = 10;
+    const char *dir = NULL, *only = NULL;
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--json") == 0) json = 1;
+        else if (strcmp(argv[i], "--models") == 0) {
+            if (cli_need_values(CMD, argc, argv, i, 1)) return CLI_USAGE;
+            dir = argv[++i];
+        } else if (strcmp(argv[i], "--only") == 0) {
+            if (cli_need_values(CMD, argc, argv, i, 1)) return CLI_USAGE;
+            only = argv[++i];
+        } else if (strcmp(argv[i], "--steps") == 0) {
+            if (cli_need_values(CMD, argc, argv, i, 1)) return CLI_USAGE;
+            int rc = cli_parse_int(CMD, "--steps", argv[++i], &steps);
+            if (rc) return rc;
+            if (steps < 1 || steps > 100000) return cli_fail("--steps must be in [1, 100000] (got %d)", steps);
+        } else if (argv[i][0] == '-') return cli_usage(CMD, "unknown option '%s'", argv[i]);
+        else return cli_usage(CMD, "unexpected argument '%s'", argv[i]);
+    }
+    if (!dir) dir = default_models_dir();
+    if (!dir) return cli_fail("no models folder: pass --models DIR or set SEM_SHARED_MODELS");
+    if (!is_dir(dir)) return cli_fail("%s: not a folder", dir);
+
+    cJSON *list = json ? cJSON_CreateArray() : NULL;
+    if (json && !list) return cli_fail("out of memory");
+    if (!json) {
+        printf("Table 1: ours / paper (s) and speed-up paper / ours; %d threads, %d steps per row\n",
+               omp_get_max_threads(), steps);
+        printf("%-19s %5s %5s | %-25s | %-25s | %-25s | %-25s | %-25s | %8s | %6s %6s\n", "example",
+               "dofs", "paper", "sample", "quad", "weights", "build Pi", "step", "factor", "Nnz%",
+               "paper");
+    }
+    int ran = 0, failed = 0;
+    for (int k = 0; k < sem_table1_count; ++k) {
+        const sem_table1_row *r = &sem_table1[k];
+        if (only && !strstr(r->example, only) && !strstr(r->file, only)) continue;
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, r->file);
+        struct stat st;
+        if (stat(path, &st) != 0) {
+            cli_warn("%s: %s not found, skipped", r->example, path);
+            continue;
+        }
+        fprintf(stderr, "sem bench: [%d/%d] %s (%s)...\n", k + 1, sem_table1_count, r->example, r->file);
+        bench_result b;
+        sem_error err;
+        sem_error_clear(&err);
+        double t0 = omp_get_wtime();
+        if (run_row(r, path, steps, &b, &err) != SEM_OK) {
+            cli_warn("%s: %s", r->example, err.message);
+            failed++;
+            continue;
+        }
+        fprintf(stderr, "sem bench: %s done in %.1f s\n", r->example, omp_get_wtime() - t0);
+        ran++;
+        if (json) {
+            cJSON *o = cJSON_CreateObject();
+            if (!o) {
+                cJSON_Delete(list);
+                return cli_fail("out of memory");
+            }
+            cJSON_AddItemToArray(list, o);
+            cJSON_AddStringToObject(o, "example", r->example);
+            cJSON_AddStringToObject(o, "file", r->file);
+            cJSON_AddNumberToObject(o, "order", r->order);
+            cJSON_AddNumberToObject(o, "dofs", b.dofs);
+            cJSON_AddNumberToObject(o, "sample_s", b.sample_s);
+            cJSON_AddNumberToObject(o, "quad_s", b.quad_s);
+            cJSON_AddNumberToObject(o, "weights_s", b.weights_s);
+            cJSON_AddNumberToObject(o, "build_pi_s", b.build_pi_s);
+            cJSON_AddNumberToObject(o, "step_s", b.step_s);
+            cJSON_AddNumberToObject(o, "factor_s", b.factor_s);
+            cJSON_AddNumberToObject(o, "nnz_percent", b.nnz_percent);
+            cJSON_AddStringToObject(o, "solver", b.solver);
+            cJSON *p = cJSON_AddObjectToObject(o, "paper");
+            if (p) {
+                cJSON_AddNumberToObject(p, "dofs", r->paper_q);
+                cJSON_AddNumberToObject(p, "sample_s", r->paper_sample);
+                cJSON_AddNumberToObject(p, "quad_s", r->paper_quad);
+                cJSON_AddNumberToObject(p, "weights_s", r->paper_weights);
+                cJSON_AddNumberToObject(p, "build_pi_s", r->paper_build_pi);
+                cJSON_AddNumberToObject(p, "step_s", r->paper_step);
+                cJSON_AddNumberToObject(p, "nnz_percent", r->paper_nnz);
+            }
+        } else {
+            printf("%-19s %5d %5d |", r->example, b.dofs, r->paper_q);
+            print_cell(b.sample_s, r->paper_sample);
+            print_cell(b.quad_s, r->paper_quad);
+            print_cell(b.weights_s, r->paper_weights);
+            print_cell(b.build_pi_s, r->paper_build_pi);
+            print_cell(b.step_s, r->paper_step);
+            printf(" %8.2e | %6.2f %6.2f\n", b.factor_s, b.nnz_percent, r->paper_nnz);
+            fflush(stdout);
+        }
+    }
+    if (json) {
+        int rc = cli_print_json(list);
+        if (rc) return rc;
+    }
+    if (ran == 0 && failed == 0) return cli_fail("no Table 1 model found in %s", dir);
+    return failed ? CLI_FAILED : CLI_OK;
+}
