@@ -84,7 +84,14 @@ typedef struct sem_object_def {
     int n_part_materials;
     double gamma;                        /* error stiffness; <= 0: disc->gamma scaled by E */
     const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
-    sem_prescribe prescribe;
+    sem_prescribe prescribe;             /* motion of every pinned point (all points when
+                                            pinned is NULL), unless prescribe_group is given */
+    /* Several prescribed groups (e.g. a twisting beam: one end fixed, the other rotating):
+     * prescribe_group[c] indexes prescribes (-1: none). A point with a group is pinned and
+     * follows that group's motion; other pinned points stay where they are. */
+    const int *prescribe_group;
+    const sem_prescribe *prescribes;
+    int n_prescribes;
     double initial_velocity[3];
     double initial_angular_velocity[3];  /* about the centre of mass */
     const sem_point_load *point_loads;

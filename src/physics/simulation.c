@@ -80,6 +80,9 @@ typedef struct object {
     double gamma;
     /* free dofs */
     unsigned char *pinned;
+    int *presc_index;          /* per ctrl: prescription followed, or -1 (stays put) */
+    sem_prescribe *presc;
+    int n_presc;
     int *free_index;           /* per ctrl: free index or -1 */
     int n_free;
     int *map;                  /* per block entry (9 per scalar entry): CSC position or -1 */
@@ -186,6 +189,8 @@ static void object_destroy(object *o)
     free(o->K0_blocks);
     free(o->f_gravity);
     free(o->pinned);
+    free(o->presc_index);
+    free(o->presc);
     free(o->free_index);
     free(o->map);
     sem_linear_solver_destroy(o->solver);
@@ -750,6 +755,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         return -1;
     }
     o->def = *def;
+    /* the caller's arrays are copied where needed; keep no pointer to them */
+    o->def.pinned = NULL;
+    o->def.prescribe_group = NULL;
+    o->def.prescribes = NULL;
     o->def.point_loads = NULL;
     o->def.region_loads = NULL;
     o->def.n_point_loads = 0;
@@ -816,8 +825,31 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         o->mass += o->point_rho_vol[p];
     }
     if (def->pinned) memcpy(o->pinned, def->pinned, (size_t)o->n_ctrl);
-    if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned)
-        memset(o->pinned, 1, (size_t)o->n_ctrl); /* prescribe all control points */
+    o->presc_index = malloc((size_t)o->n_ctrl * sizeof(int));
+    o->n_presc = def->prescribe_group ? def->n_prescribes : 1;
+    o->presc = calloc((size_t)(o->n_presc > 0 ? o->n_presc : 1), sizeof(sem_prescribe));
+    if (!o->presc_index || !o->presc) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (def->prescribe_group) {
+        if (def->n_prescribes > 0) memcpy(o->presc, def->prescribes, (size_t)def->n_prescribes * sizeof(sem_prescribe));
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            int g = def->prescribe_group[c];
+            if (g >= def->n_prescribes) {
+                sem_error_set(err, SEM_ERR_INVALID, "control point %d: prescribed group %d does not exist", c, g);
+                goto fail;
+            }
+            o->presc_index[c] = g >= 0 ? g : -1;
+            if (g >= 0) o->pinned[c] = 1;
+        }
+    } else {
+        o->presc[0] = def->prescribe;
+        if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned)
+            memset(o->pinned, 1, (size_t)o->n_ctrl); /* prescribe all control points */
+        for (int c = 0; c < o->n_ctrl; ++c)
+            o->presc_index[c] = def->prescribe.type != SEM_PRESCRIBE_NONE && o->pinned[c] ? 0 : -1;
+    }
     o->n_free = 0;
     for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
     /* error stiffness: the discretization's default is for its E; rescale to ours */
@@ -1081,7 +1113,11 @@ static void fill_system(object *o, double cM, double cE, double cK, double cD)
 static void prescribed_position(const object *o, double t, int c, double out[3])
 {
     const double *x0 = o->q0 + 3 * c;
-    const sem_prescribe *pr = &o->def.prescribe;
+    if (o->presc_index[c] < 0) {
+        memcpy(out, o->q + 3 * c, 3 * sizeof(double));
+        return;
+    }
+    const sem_prescribe *pr = &o->presc[o->presc_index[c]];
     if (pr->type == SEM_PRESCRIBE_AFFINE) {
         const double *A = pr->affine;
         for (int r = 0; r < 3; ++r) out[r] = A[4 * r] * x0[0] + A[4 * r + 1] * x0[1] + A[4 * r + 2] * x0[2] + A[4 * r + 3];
@@ -1235,10 +1271,9 @@ done:
 
 /* Newton on E(q) = 1/(2h^2) |q - q_pred|_M^2 + V(q) + gamma q^T M_eps q - f^T q (+ damping),
  * or, when h == 0 (statics), E(q) = V(q) + gamma q^T M_eps q - f^T q. */
-static sem_status newton_solve(sem_world *w, object *o, double h, sem_error *err)
+static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem_error *err)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
-    double t1 = w->time + (h > 0 ? h : 0);
     int dynamic = h > 0;
     double cM = dynamic ? 1.0 / (h * h) + w->def.rayleigh_mass / h : 0.0;
     double cD = dynamic ? w->def.rayleigh_stiffness / h : 0.0;
@@ -1387,8 +1422,9 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
         sem_status st;
         switch (w->def.integrator) {
         case SEM_LINEARLY_IMPLICIT_EULER: st = step_linearly_implicit(w, o, err); break;
-        case SEM_IMPLICIT_EULER: st = newton_solve(w, o, w->def.dt, err); break;
-        default: st = newton_solve(w, o, 0.0, err); break;
+        case SEM_IMPLICIT_EULER: st = newton_solve(w, o, w->def.dt, w->time + w->def.dt, err); break;
+        /* quasi-static: equilibrium with the loads and prescribed motion of t + dt */
+        default: st = newton_solve(w, o, 0.0, w->time + w->def.dt, err); break;
         }
         if (st != SEM_OK) return st;
     }
@@ -1403,7 +1439,7 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
     int saved = w->def.newton_max_iterations;
     if (saved < 200) w->def.newton_max_iterations = 200;
     for (int i = 0; i < w->n_objects; ++i) {
-        sem_status st = newton_solve(w, w->objects[i], 0.0, err);
+        sem_status st = newton_solve(w, w->objects[i], 0.0, w->time, err);
         if (st != SEM_OK) {
             w->def.newton_max_iterations = saved;
             return st;
