@@ -314,7 +314,7 @@ static void test_hand_made(int order)
     check_properties(d, d->sample_X, what, 1);
     CHECK_NEAR(d->stiffness_nnz_percent, 100.0, 1e-12);
     CHECK_REL(d->length_scale, 2.0 * sqrt(3.0), 1e-12);
-    CHECK_REL(d->gamma, 1e6 / d->length_scale, 1e-15);
+    CHECK_REL(d->gamma, 1000.0 * 1e6 / d->length_scale, 1e-15);
 
     /* determinism: 1 thread vs 2 threads give bitwise identical operators */
     sem_discretization *d1 = make_cube(order, 5, 1, 11);

@@ -93,6 +93,9 @@ typedef struct object {
     double *Kz;                /* n_pairs x (3m)^2 */
     int nthreads;
     double *Kz_thread, *grad_z_thread;
+    int max_row;               /* most parts with weight at one quadrature point */
+    double *hg_thread;         /* per thread: max_row x 9 x 3m */
+    double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
     double elastic_energy;
     double volume, mass;
 } object;
@@ -198,6 +201,8 @@ static void object_destroy(object *o)
     free(o->grad_z);
     free(o->Kz);
     free(o->Kz_thread);
+    free(o->hg_thread);
+    free(o->qc);
     free(o->grad_z_thread);
     free((void *)o->def.point_loads);
     free((void *)o->def.region_loads);
@@ -371,6 +376,19 @@ static sem_status setup_pairs(object *o, sem_error *err)
     memcpy(fill, o->gpair_pairs_start, (size_t)o->n_gpairs * sizeof(int));
     for (int k = 0; k < o->n_pairs; ++k) o->gpair_pairs[fill[o->part_pair_gpair[k]]++] = k;
     free(fill);
+    /* within a group pair, pairs with the same first part are consecutive (see the
+     * projection in assemble_elastic) */
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int a = o->gpair_pairs_start[g], b = o->gpair_pairs_start[g + 1];
+        for (int k = a + 1; k < b; ++k) {
+            int x = o->gpair_pairs[k], j = k - 1;
+            while (j >= a && o->pair_a[o->gpair_pairs[j]] > o->pair_a[x]) {
+                o->gpair_pairs[j + 1] = o->gpair_pairs[j];
+                --j;
+            }
+            o->gpair_pairs[j + 1] = x;
+        }
+    }
     size_t total = o->gpair_offset[o->n_gpairs];
     o->K_blocks = calloc(9 * total + 1, sizeof(double));
     o->K0_blocks = calloc(9 * total + 1, sizeof(double));
@@ -863,6 +881,15 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->Kz = malloc((kz + 1) * sizeof(double));
     o->Kz_thread = malloc(((size_t)o->nthreads * kz + 1) * sizeof(double));
     o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->m * 3 + 1) * sizeof(double));
+    o->max_row = 1;
+    for (int p = 0; p < o->n_quad; ++p)
+        if (d->W.row_start[p + 1] - d->W.row_start[p] > o->max_row) o->max_row = d->W.row_start[p + 1] - d->W.row_start[p];
+    o->hg_thread = malloc((size_t)o->nthreads * o->max_row * 9 * 3 * o->m * sizeof(double));
+    o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
+    if (!o->hg_thread || !o->qc) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
     if (!o->Kz || !o->Kz_thread || !o->grad_z_thread) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
@@ -919,6 +946,34 @@ fail:
 /* ---------------------------------------------------------------------------------- */
 /* assembly                                                                            */
 
+/* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
+ * energies are translation invariant, but evaluated at q far from the origin their
+ * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
+ * slowly lose momentum conservation. Evaluating at the centred q removes that. */
+static const double *centered(object *o, const double *q)
+{
+    double mean[3] = {0, 0, 0};
+    for (int c = 0; c < o->n_ctrl; ++c)
+        for (int k = 0; k < 3; ++k) mean[k] += q[3 * c + k];
+    for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+    for (int c = 0; c < o->n_ctrl; ++c)
+        for (int k = 0; k < 3; ++k) o->qc[3 * c + k] = q[3 * c + k] - mean[k];
+    return o->qc;
+}
+
+static void blocks_multiply(const object *o, double cM, double cE, double cK, double cD,
+                            const double *x, double *y);
+
+/* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (in grad). */
+static double error_term(object *o, const double *q, double *grad)
+{
+    const double *qc = centered(o, q);
+    blocks_multiply(o, 0, o->gamma, 0, 0, qc, grad);
+    double e = 0;
+    for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) e += 0.5 * qc[i] * grad[i];
+    return e;
+}
+
 /* Elastic energy, gradient in q (if grad_q) and, if want_hessian, K_blocks. */
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
                                    sem_error *err)
@@ -928,8 +983,8 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     int m = o->m, m3 = 3 * m;
     size_t nz = (size_t)o->n_parts * m * 3;
     size_t kz = (size_t)o->n_pairs * m3 * m3;
-    /* z = Pi Q */
-    sem_csr_multiply(&d->Pi, q, 3, o->z);
+    /* z = Pi Q, with Q centred (translation invariance; see centered) */
+    sem_csr_multiply(&d->Pi, centered(o, q), 3, o->z);
     int nth = o->nthreads;
     double energy_total = 0;
     int bad = 0;
@@ -947,7 +1002,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
         /* static contiguous chunks: deterministic for a fixed thread count */
         int chunk = (o->n_quad + nt - 1) / nt;
         int p0 = t * chunk, p1 = p0 + chunk < o->n_quad ? p0 + chunk : o->n_quad;
-        double HG[9 * 30];
+        double *HG = o->hg_thread + (size_t)t * o->max_row * 9 * m3;
         for (int p = p0; p < p1; ++p) {
             int r0 = W->row_start[p], r1 = W->row_start[p + 1];
             double F[9] = {0};
@@ -981,18 +1036,27 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
             }
             if (!want_hessian) continue;
             int pp = o->entry_pair_offset[p];
+            /* HG_b[(d,e)][(d',k')] = sum_e' H[(d,e),(d',e')] g_b[k'][e'], once per part b */
+            for (int rb = r0; rb < r1; ++rb) {
+                const double *gb = o->entry_grad + (size_t)rb * m * 3;
+                double *HGb = HG + (size_t)(rb - r0) * 9 * m3;
+                for (int de = 0; de < 9; ++de)
+                    for (int d2 = 0; d2 < 3; ++d2) {
+                        const double *h = H + de * 9 + d2 * 3;
+                        for (int k2 = 0; k2 < m; ++k2)
+                            HGb[de * m3 + d2 * m + k2] =
+                                h[0] * gb[k2 * 3 + 0] + h[1] * gb[k2 * 3 + 1] + h[2] * gb[k2 * 3 + 2];
+                    }
+            }
             for (int ra = r0; ra < r1; ++ra) {
                 const double *ga = o->entry_grad + (size_t)ra * m * 3;
                 for (int rb = r0; rb < r1; ++rb) {
-                    const double *gb = o->entry_grad + (size_t)rb * m * 3;
-                    /* HG[(d,e)][(k',d')] = sum_e' H[(d,e),(d',e')] gb[k'][e'] */
-                    for (int de = 0; de < 9; ++de)
-                        for (int k2 = 0; k2 < m; ++k2)
-                            for (int d2 = 0; d2 < 3; ++d2) {
-                                const double *h = H + de * 9 + d2 * 3;
-                                HG[de * m3 + d2 * m + k2] =
-                                    h[0] * gb[k2 * 3 + 0] + h[1] * gb[k2 * 3 + 1] + h[2] * gb[k2 * 3 + 2];
-                            }
+                    /* symmetric: only b >= a here, the mirror block is filled after the sum */
+                    if (rb < ra) {
+                        pp++;
+                        continue;
+                    }
+                    const double *HGb = HG + (size_t)(rb - r0) * 9 * m3;
                     /* Kz[(d,k)][(d',k')] += vol sum_e ga[k][e] HG[(d,e)][(d',k')] */
                     double *K = Kt + (size_t)o->point_pairs[pp++] * m3 * m3;
                     for (int d1 = 0; d1 < 3; ++d1)
@@ -1000,8 +1064,8 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                             double a0 = vol * ga[k1 * 3 + 0], a1 = vol * ga[k1 * 3 + 1],
                                    a2 = vol * ga[k1 * 3 + 2];
                             if (a0 == 0 && a1 == 0 && a2 == 0) continue;
-                            const double *h0 = HG + (d1 * 3 + 0) * m3, *h1 = HG + (d1 * 3 + 1) * m3,
-                                         *h2 = HG + (d1 * 3 + 2) * m3;
+                            const double *h0 = HGb + (d1 * 3 + 0) * m3, *h1 = HGb + (d1 * 3 + 1) * m3,
+                                         *h2 = HGb + (d1 * 3 + 2) * m3;
                             double *Krow = K + (size_t)(d1 * m + k1) * m3;
                             for (int c = 0; c < m3; ++c) Krow[c] += a0 * h0[c] + a1 * h1[c] + a2 * h2[c];
                         }
@@ -1028,29 +1092,48 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
         const double *src = o->Kz_thread + (size_t)t * kz;
         for (size_t k = 0; k < kz; ++k) o->Kz[k] += src[k];
     }
+    /* mirror: Kz(b,a) = Kz(a,b)^T for a < b (W rows list parts in increasing order) */
+    for (int pr = 0; pr < o->n_pairs; ++pr) {
+        int a = o->pair_a[pr], b = o->pair_b[pr];
+        if (a <= b) continue;
+        const double *src = o->Kz + (size_t)o->pair_lookup[(size_t)b * o->n_parts + a] * m3 * m3;
+        double *dst = o->Kz + (size_t)pr * m3 * m3;
+        for (int x = 0; x < m3; ++x)
+            for (int y = 0; y < m3; ++y) dst[x * m3 + y] = src[y * m3 + x];
+    }
     /* K_q blocks = sum over part pairs Pi_a^T Kz Pi_b per coordinate pair */
     size_t mg = max_group(o);
     int fail = 0;
 #pragma omp parallel num_threads(nth) reduction(| : fail)
     {
-        double *tmp = malloc((size_t)m * mg * sizeof(double));
-        if (!tmp) fail = 1;
+        /* Block(ga,gb) = sum_a Pi_a^T (sum_b Kz_ab Pi_b): the inner sum first, so the
+         * expensive product with Pi_a^T is done once per part a, not per pair */
+        double *U = malloc(9 * (size_t)m * mg * sizeof(double));
+        if (!U) fail = 1;
 #pragma omp for schedule(dynamic, 4)
         for (int g = 0; g < o->n_gpairs; ++g) {
-            if (!tmp) continue;
-            size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
+            if (!U) continue;
+            int na = (int)gsize(o, o->gpair_a[g]), nb = (int)gsize(o, o->gpair_b[g]);
             double *blk = o->K_blocks + 9 * o->gpair_offset[g];
-            memset(blk, 0, 9 * na * nb * sizeof(double));
-            for (int k = o->gpair_pairs_start[g]; k < o->gpair_pairs_start[g + 1]; ++k) {
-                int pr = o->gpair_pairs[k];
-                const double *K = o->Kz + (size_t)pr * m3 * m3;
-                for (int d1 = 0; d1 < 3; ++d1)
-                    for (int d2 = 0; d2 < 3; ++d2)
-                        add_projected(o, o->pair_a[pr], o->pair_b[pr], K + (size_t)(d1 * m) * m3 + d2 * m,
-                                      m3, blk + (size_t)(d1 * 3 + d2) * na * nb, tmp);
+            memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
+            int k = o->gpair_pairs_start[g], end = o->gpair_pairs_start[g + 1];
+            while (k < end) {
+                int a = o->pair_a[o->gpair_pairs[k]];
+                memset(U, 0, 9 * (size_t)m * nb * sizeof(double));
+                for (; k < end && o->pair_a[o->gpair_pairs[k]] == a; ++k) {
+                    int pr = o->gpair_pairs[k], b = o->pair_b[pr];
+                    const double *K = o->Kz + (size_t)pr * m3 * m3;
+                    for (int dd = 0; dd < 9; ++dd)
+                        cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, m, nb, m, 1.0,
+                                    K + (size_t)((dd / 3) * m) * m3 + (dd % 3) * m, m3, o->pi_dense[b], nb, 1.0,
+                                    U + (size_t)dd * m * nb, nb);
+                }
+                for (int dd = 0; dd < 9; ++dd)
+                    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[a], na,
+                                U + (size_t)dd * m * nb, nb, 1.0, blk + (size_t)dd * na * nb, nb);
             }
         }
-        free(tmp);
+        free(U);
     }
     if (fail) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     return SEM_OK;
@@ -1227,7 +1310,7 @@ static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err
     if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
     external_force(o, w->time, f);
     /* f_total = f_ext - grad V - 2 gamma M_eps q */
-    blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
+    error_term(o, o->q, tmp);
     for (size_t i = 0; i < n; ++i) f[i] -= g[i] + tmp[i];
     /* rhs = M v + h f - h C v ... damping enters the matrix: (M + hC + h^2K) v+ = M v + h f */
     blocks_multiply(o, 1.0, 0, 0, 0, o->v, rhs);
@@ -1305,9 +1388,8 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
         if (assemble_elastic(o, (qq), 0, NULL, &e_) != SEM_OK) {                          \
             (out) = INFINITY;                                                              \
         } else {                                                                           \
-            double E_ = o->elastic_energy;                                                 \
-            blocks_multiply(o, 0, o->gamma, 0, 0, (qq), tmp);                              \
-            for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * (qq)[i_] * tmp[i_] - f[i_] * (qq)[i_]; \
+            double E_ = o->elastic_energy + error_term(o, (qq), tmp);                      \
+            for (size_t i_ = 0; i_ < n; ++i_) E_ -= f[i_] * (qq)[i_];                      \
             if (dynamic) {                                                                 \
                 for (size_t i_ = 0; i_ < n; ++i_) dq[i_] = (qq)[i_] - qpred[i_];           \
                 blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);                       \
@@ -1327,7 +1409,7 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
     for (it = 0; it < w->def.newton_max_iterations; ++it) {
         if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
         /* gradient: grad V + 2 gamma M_eps q - f + M (q - q_pred)/h^2 + damping */
-        blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
+        error_term(o, o->q, tmp);
         for (size_t i = 0; i < n; ++i) g[i] += tmp[i] - f[i];
         if (dynamic) {
             for (size_t i = 0; i < n; ++i) dq[i] = o->q[i] - qpred[i];
@@ -1520,8 +1602,7 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
     /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
     blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
     for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
-    blocks_multiply(o, 0, o->gamma, 0, 0, o->q, tmp);
-    for (size_t k = 0; k < n; ++k) s->error_energy += 0.5 * o->q[k] * tmp[k];
+    s->error_energy = error_term(o, o->q, tmp);
     sem_error e;
     if (assemble_elastic(o, o->q, 0, NULL, &e) == SEM_OK)
         s->elastic_energy = o->elastic_energy;

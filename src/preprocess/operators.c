@@ -31,7 +31,7 @@
  *
  * Default gamma (Sec. 7.6): the error energy gamma * integral_boundary |Gamma q - J q|^2 dA has
  * units gamma x m^4 while elastic energy is Pa x m^3, so gamma must be a stiffness per length:
- * gamma = kappa E / L, L = bounding-box diagonal of the boundary samples, kappa = 1. See
+ * gamma = kappa E / L, L = bounding-box diagonal of the boundary samples, kappa = 1000. See
  * docs/preprocessing.md for the reasoning and for converting the paper's unweighted gammas.
  */
 #include <math.h>
@@ -490,7 +490,7 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
         if (d->n_samples > 0)
             for (int e = 0; e < 3; ++e) L2 += (hi[e] - lo[e]) * (hi[e] - lo[e]);
         d->length_scale = sqrt(L2);
-        const double kappa = 1.0;
+        const double kappa = 1000.0; /* see docs/preprocessing.md, "Default gamma" */
         double E = (o && o->youngs_modulus > 0) ? o->youngs_modulus : 1e6;
         if (o && o->gamma > 0)
             d->gamma = o->gamma;
