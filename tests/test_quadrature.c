@@ -230,7 +230,7 @@ static void test_sphere_convergence(void)
         double ed = fabs(d.volume / exact - 1);
         printf("sphere default options (%dx%d rays, tessellation %d): relative error %.3e\n",
                o.rays[0], o.rays[1], o.tessellation, ed);
-        CHECK(ed < (o.rays[0] >= 40 && o.rays[1] >= 40 ? 1e-3 : 1.5e-2), "default: %g", ed);
+        CHECK(ed < 1e-3, "default settings: sphere volume off by %g (> 0.1%%)", ed);
         free_quad(&d);
     }
     sem_model_destroy(m);

@@ -30,9 +30,9 @@ extern "C" {
 
 typedef struct sem_preprocess_options {
     int order;               /* 1 (linear) or 2 (quadratic, default) */
-    int rays[2];             /* ray grid (n1, n2) across the ray axis; default 10 x 10 */
+    int rays[2];             /* ray grid (n1, n2) across the ray axis; default 40 x 40 */
     int ray_axis;            /* 0 = x (default), 1 = y, 2 = z */
-    int points_per_interval; /* volume points per inside interval; default 5 */
+    int points_per_interval; /* volume points per inside interval; default 2 */
     double alpha;            /* weight cut-off distance, model units; <= 0: use sparsity */
     double sparsity;         /* target non-zero fraction T in (0,1) when alpha <= 0;
                                 when both are unset (alpha 0, sparsity 0): alpha = 0.5 x
@@ -40,14 +40,19 @@ typedef struct sem_preprocess_options {
     double weight_threshold; /* weights below are dropped; default 1e-4 */
     double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
     double youngs_modulus;   /* for the default gamma; default 1e6 */
-    int tessellation;        /* triangle grid cells per knot span per direction; default 8 */
+    int tessellation;        /* triangle grid cells per knot span per direction; default 16 */
     int threads;             /* 0: OpenMP default */
 } sem_preprocess_options;
 
 sem_preprocess_options sem_default_preprocess_options(void);
 
 typedef struct sem_preprocess_timings {
-    double sample_s, quad_s, weights_s, build_pi_s, operators_s;
+    double sample_s;     /* boundary sampling (Table 1's Sample) */
+    double scene_s;      /* tessellation + Embree build + orientation fix (not in Table 1) */
+    double quad_s;       /* ray-cast volume quadrature (Table 1's Quad) */
+    double weights_s;    /* blending weights + origins (Table 1's Weights) */
+    double build_pi_s;   /* projection Pi (Table 1's Build Pi) */
+    double operators_s;  /* Gamma, M, M_eps (not in Table 1) */
 } sem_preprocess_timings;
 
 typedef struct sem_discretization {

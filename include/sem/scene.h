@@ -24,6 +24,17 @@ typedef struct sem_scene_part_material {
     sem_material material;
 } sem_scene_part_material;
 
+/* One prescribed motion with its own control point selection ("prescribe": [...]). */
+typedef struct sem_scene_prescribe_group {
+    int has_box;
+    double box[6];
+    int n_parts;
+    int *parts;
+    int n_points;
+    int *points;
+    sem_prescribe prescribe;
+} sem_scene_prescribe_group;
+
 typedef struct sem_scene_object {
     char model_path[4096];   /* resolved relative to the scene file; "" for a primitive */
     char primitive[16];      /* "box", "beam", "sphere", "cylinder", "torus" or "" */
@@ -41,7 +52,9 @@ typedef struct sem_scene_object {
     int *pin_parts;
     int n_pin_points;
     int *pin_points;
-    sem_prescribe prescribe;
+    sem_prescribe prescribe;          /* "prescribe": {...}: moves every pinned point */
+    int n_prescribe_groups;           /* "prescribe": [{pin, affine|rotate}, ...] */
+    sem_scene_prescribe_group *prescribe_groups;
     double initial_velocity[3];
     double initial_angular_velocity[3];
     int n_point_loads;
@@ -76,6 +89,10 @@ sem_status sem_scene_object_model(const sem_scene *scene, int object, sem_model 
 /* Per control point pin flags (1 = pinned) for the object's model; caller frees. */
 sem_status sem_scene_object_pins(const sem_scene_object *obj, const sem_model *model,
                                  unsigned char **out, sem_error *err);
+/* Per control point index into prescribe_groups (-1: none), or *out = NULL when the object
+ * has no prescribe groups. A group that selects no control point is an error. */
+sem_status sem_scene_object_prescribe_groups(const sem_scene_object *obj, const sem_model *model,
+                                             int **out, sem_error *err);
 /* Per part material index into part_materials (or -1); caller frees. */
 sem_status sem_scene_object_part_materials(const sem_scene_object *obj, const sem_model *model,
                                            int **out, sem_material **materials, sem_error *err);

@@ -30,6 +30,7 @@ int cmd_inspect(int argc, char **argv);
 int cmd_convert(int argc, char **argv);
 int cmd_preprocess(int argc, char **argv);
 int cmd_run(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
 
 /* ---- messages (main.c) ---- */
 /* Prints "sem: <message>" on stderr; returns CLI_FAILED. */

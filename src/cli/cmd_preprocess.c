@@ -52,6 +52,7 @@ static cJSON *to_json(const sem_discretization *d, double total_s)
         return NULL;
     }
     cJSON_AddNumberToObject(t, "sample_s", d->timings.sample_s);
+    cJSON_AddNumberToObject(t, "scene_s", d->timings.scene_s);
     cJSON_AddNumberToObject(t, "quad_s", d->timings.quad_s);
     cJSON_AddNumberToObject(t, "weights_s", d->timings.weights_s);
     cJSON_AddNumberToObject(t, "build_pi_s", d->timings.build_pi_s);

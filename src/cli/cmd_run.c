@@ -90,6 +90,8 @@ typedef struct run_state {
     sem_discretization **discs;
     unsigned char **pins;
     int **part_mat;
+    int **presc_group;
+    sem_prescribe **prescs;
     sem_material **mats;
     sem_world *world;
     sem_animation *anim;
@@ -206,12 +208,16 @@ static void run_free(run_state *r)
         if (r->models) sem_model_destroy(r->models[i]);
         if (r->pins) free(r->pins[i]);
         if (r->part_mat) free(r->part_mat[i]);
+        if (r->presc_group) free(r->presc_group[i]);
+        if (r->prescs) free(r->prescs[i]);
         if (r->mats) free(r->mats[i]);
     }
     free(r->models);
     free(r->discs);
     free(r->pins);
     free(r->part_mat);
+    free(r->presc_group);
+    free(r->prescs);
     free(r->mats);
     cJSON_Delete(r->frames);
     sem_scene_destroy(r->scene);
@@ -260,10 +266,12 @@ int cmd_run(int argc, char **argv)
     r.discs = calloc((size_t)r.n, sizeof *r.discs);
     r.pins = calloc((size_t)r.n, sizeof *r.pins);
     r.part_mat = calloc((size_t)r.n, sizeof *r.part_mat);
+    r.presc_group = calloc((size_t)r.n, sizeof *r.presc_group);
+    r.prescs = calloc((size_t)r.n, sizeof *r.prescs);
     r.mats = calloc((size_t)r.n, sizeof *r.mats);
     r.frames = cJSON_CreateArray();
     int rc = CLI_FAILED;
-    if (!r.models || !r.discs || !r.pins || !r.part_mat || !r.mats || !r.frames) {
+    if (!r.models || !r.discs || !r.pins || !r.part_mat || !r.mats || !r.presc_group || !r.prescs || !r.frames) {
         cli_fail("out of memory");
         goto done;
     }
@@ -293,7 +301,8 @@ int cmd_run(int argc, char **argv)
                     r.discs[i]->volume);
         const sem_scene_object *so = &r.scene->objects[i];
         if ((st = sem_scene_object_pins(so, r.models[i], &r.pins[i], &err)) != SEM_OK ||
-            (st = sem_scene_object_part_materials(so, r.models[i], &r.part_mat[i], &r.mats[i], &err)) != SEM_OK) {
+            (st = sem_scene_object_part_materials(so, r.models[i], &r.part_mat[i], &r.mats[i], &err)) != SEM_OK ||
+            (st = sem_scene_object_prescribe_groups(so, r.models[i], &r.presc_group[i], &err)) != SEM_OK) {
             cli_fail("%s: objects[%d].%s", r.scene->path[0] ? r.scene->path : "default scene", i, err.message);
             goto done;
         }
@@ -306,6 +315,17 @@ int cmd_run(int argc, char **argv)
         od.n_part_materials = so->n_part_materials;
         od.pinned = r.pins[i];
         od.prescribe = so->prescribe;
+        if (r.presc_group[i]) {
+            r.prescs[i] = malloc((size_t)so->n_prescribe_groups * sizeof(sem_prescribe));
+            if (!r.prescs[i]) {
+                cli_fail("out of memory");
+                goto done;
+            }
+            for (int g = 0; g < so->n_prescribe_groups; ++g) r.prescs[i][g] = so->prescribe_groups[g].prescribe;
+            od.prescribe_group = r.presc_group[i];
+            od.prescribes = r.prescs[i];
+            od.n_prescribes = so->n_prescribe_groups;
+        }
         memcpy(od.initial_velocity, so->initial_velocity, sizeof od.initial_velocity);
         memcpy(od.initial_angular_velocity, so->initial_angular_velocity, sizeof od.initial_angular_velocity);
         od.point_loads = so->point_loads;

@@ -46,7 +46,7 @@ static const cli_command commands[] = {
      "           bbox, area, units, warnings, part_details) instead of text\n"},
     {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
      "  IN and OUT: .igs/.iges or .obj\n"},
-    {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (10 10) across --axis (x)  --points-per-interval N (5)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the bbox diagonal\n  --gamma G (default E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (8)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file for sem simulate)\n"},
+    {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (40 40) across --axis (x)  --points-per-interval N (2)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the bbox diagonal\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (16)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n"},
     {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--quiet]",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
      "  SCENE       a scene file (JSON, see docs/scenes.md); without it the embedded default\n"
@@ -56,6 +56,7 @@ static const cli_command commands[] = {
      "  --quiet     no progress output\n"
      "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
      "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
+    {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (10)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, paper)\n"},
 };
 
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);

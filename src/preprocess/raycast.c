@@ -6,8 +6,10 @@
  *   geomID is the part directly. Parts whose tessellation is empty (fully trimmed away)
  *   simply have no geometry. The scene uses RTC_SCENE_FLAG_ROBUST (watertight traversal:
  *   a ray through a shared edge hits at least one of the two triangles) and
- *   RTC_BUILD_QUALITY_HIGH (spatial splits: faster traversal; a triangle may then be
- *   reported twice, which the all-hits query removes).
+ *   RTC_BUILD_QUALITY_LOW (Morton build: a scene serves one preprocessing run, where the
+ *   build costs more than the few rays per triangle gain from a better tree). The device
+ *   is shared by the process (see acquire_device). The all-hits query still removes a
+ *   triangle reported twice, which higher build qualities (spatial splits) can do.
  * - Precision. Embree works in single precision. We keep the tessellation in double and
  *   recompute every hit distance in double as the ray-plane distance of the hit triangle:
  *   t = ((v0 - o) . n) / (d . n). So a hit's t is exact to double rounding for the
@@ -51,9 +53,12 @@
  *   divided by 4 pi. sem_raycast_winding_number_exact sums every triangle;
  *   sem_raycast_winding_number uses Barill et al.'s (2018) tree with a first-order
  *   (dipole) far field, within 5e-3 of the exact value (see below). Both re-entrant.
- * - Closest parts: rtcPointQuery with a callback that computes the exact double-precision
- *   point-triangle distance (Ericson, Real-Time Collision Detection, 5.1.5) and keeps the
- *   minimum per part within the radius, in a per-call context (thread-safe).
+ * - Closest parts: exact double-precision point-triangle distances (Ericson, Real-Time
+ *   Collision Detection, 5.1.5), minimum per part within the radius. The public query walks
+ *   a small box tree per part (built on first use) with a radius that shrinks to the best
+ *   distance so far; the component search at scene build uses one Embree rtcPointQuery
+ *   (its radius is tiny). The winding-number tree is also built on first use.
+ * - Orientation votes stop as soon as the votes not cast yet cannot change the sign.
  */
 #include "raycast.h"
 
@@ -167,7 +172,6 @@ struct sem_raycast_scene {
     int *part_root;           /* n_parts: root node of each part, -1 when empty */
     int *part_tri_order;      /* triangles in tree order (global indices) */
     int parts_built, parts_failed;
-    unsigned char *part_sealed; /* n_parts: every boundary sample touches other geometry */
     sem_surface *surfaces; /* copies of the parts' surfaces, for exact hit refinement */
     double lo[3], hi[3];
     double scale;         /* bounding-box diagonal (> 0) */
@@ -585,8 +589,10 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
     return false; /* never shrink the radius: every part within it is wanted */
 }
 
-int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3], double radius,
-                              int *out_parts, double *out_dist, double *out_points)
+/* Closest parts by one Embree point query over the whole scene (cost: every triangle within
+ * the radius); used for the small radii of the component search. */
+static int closest_parts_embree(const sem_raycast_scene *scene, const double X[3], double radius,
+                                int *out_parts, double *out_dist, double *out_points)
 {
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
         return 0;
@@ -637,6 +643,210 @@ int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3],
     if (slot != slot_local) free(slot);
     return c.n_found;
 }
+
+/* Per-part trees for closest-point queries. One Embree query over the whole scene visits
+ * every triangle within the radius, which for the weights' radius alpha (often half the
+ * model) is most of the model per point. Instead each part gets its own small tree of
+ * axis-aligned boxes (in double); a query walks the parts in index order, skips a part
+ * whose box is farther than the radius and, inside a part, shrinks its search radius to
+ * the best distance so far (nearer child first): about log(triangles) work per part. */
+#define PART_LEAF 4
+
+typedef struct part_node {
+    double lo[3], hi[3];
+    int left, right;  /* children, -1 for a leaf */
+    int first, count; /* leaf: range in part_tri_order */
+} part_node;
+
+static int build_part_node(sem_raycast_scene *s, const double *centroid, int *n_nodes, int first,
+                           int count)
+{
+    int id = (*n_nodes)++;
+    part_node *node = &s->part_nodes[id];
+    int *o = s->part_tri_order + first;
+    double clo[3], chi[3];
+    for (int d = 0; d < 3; d++) {
+        node->lo[d] = clo[d] = INFINITY;
+        node->hi[d] = chi[d] = -INFINITY;
+    }
+    for (int k = 0; k < count; k++) {
+        const double *v = s->tri + 9 * (size_t)o[k];
+        for (int c = 0; c < 3; c++)
+            for (int d = 0; d < 3; d++) {
+                if (v[3 * c + d] < node->lo[d]) node->lo[d] = v[3 * c + d];
+                if (v[3 * c + d] > node->hi[d]) node->hi[d] = v[3 * c + d];
+            }
+        for (int d = 0; d < 3; d++) {
+            double x = centroid[3 * (size_t)o[k] + d];
+            if (x < clo[d]) clo[d] = x;
+            if (x > chi[d]) chi[d] = x;
+        }
+    }
+    node->first = first;
+    node->count = count;
+    node->left = node->right = -1;
+    if (count <= PART_LEAF) return id;
+    int axis = 0;
+    for (int d = 1; d < 3; d++)
+        if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
+    int half = count / 2;
+    int l = 0, r = count - 1; /* quickselect the median centroid on the axis */
+    while (l < r) {
+        double pivot = centroid[3 * (size_t)o[(l + r) / 2] + axis];
+        int i = l, j = r;
+        while (i <= j) {
+            while (centroid[3 * (size_t)o[i] + axis] < pivot) i++;
+            while (centroid[3 * (size_t)o[j] + axis] > pivot) j--;
+            if (i <= j) {
+                int tmp = o[i];
+                o[i] = o[j];
+                o[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (half <= j)
+            r = j;
+        else if (half >= i)
+            l = i;
+        else
+            break;
+    }
+    int left = build_part_node(s, centroid, n_nodes, first, half);
+    int right = build_part_node(s, centroid, n_nodes, first + half, count - half);
+    s->part_nodes[id].left = left;
+    s->part_nodes[id].right = right;
+    return id;
+}
+
+static int build_part_trees(sem_raycast_scene *s)
+{
+    int n = s->n_triangles;
+    s->part_nodes = malloc((size_t)(2 * n + s->n_parts) * sizeof *s->part_nodes);
+    s->part_tri_order = malloc((size_t)n * sizeof *s->part_tri_order);
+    s->part_root = malloc((size_t)s->n_parts * sizeof *s->part_root);
+    double *centroid = malloc((size_t)n * 3 * sizeof *centroid);
+    if (!s->part_nodes || !s->part_tri_order || !s->part_root || !centroid) {
+        free(centroid);
+        free(s->part_nodes);
+        free(s->part_tri_order);
+        free(s->part_root);
+        s->part_nodes = NULL;
+        s->part_tri_order = NULL;
+        s->part_root = NULL;
+        return 0;
+    }
+    for (int t = 0; t < n; t++) {
+        s->part_tri_order[t] = t;
+        const double *v = s->tri + 9 * (size_t)t;
+        for (int d = 0; d < 3; d++) centroid[3 * (size_t)t + d] = (v[d] + v[3 + d] + v[6 + d]) / 3;
+    }
+    int n_nodes = 0;
+    for (int p = 0; p < s->n_parts; p++) {
+        int t0 = s->part_tri_offset[p], t1 = s->part_tri_offset[p + 1];
+        s->part_root[p] = t1 > t0 ? build_part_node(s, centroid, &n_nodes, t0, t1 - t0) : -1;
+    }
+    free(centroid);
+    return 1;
+}
+
+static int ensure_part_trees(const sem_raycast_scene *scene)
+{
+    if (__atomic_load_n(&scene->parts_built, __ATOMIC_ACQUIRE)) return !scene->parts_failed;
+    sem_raycast_scene *s = (sem_raycast_scene *)scene; /* lazily filled cache */
+#pragma omp critical(sem_raycast_part_trees)
+    {
+        if (!__atomic_load_n(&s->parts_built, __ATOMIC_ACQUIRE)) {
+            s->parts_failed = !build_part_trees(s);
+            __atomic_store_n(&s->parts_built, 1, __ATOMIC_RELEASE);
+        }
+    }
+    return !scene->parts_failed;
+}
+
+static double box_distance2(const part_node *node, const double *X)
+{
+    double d2 = 0;
+    for (int d = 0; d < 3; d++) {
+        double e = 0;
+        if (X[d] < node->lo[d]) e = node->lo[d] - X[d];
+        else if (X[d] > node->hi[d]) e = X[d] - node->hi[d];
+        d2 += e * e;
+    }
+    return d2;
+}
+
+/* Closest point of one part within radius: returns 1 and fills *dist and q when found.
+ * Ties go to the lowest triangle index, so the answer does not depend on the walk. */
+static int closest_in_part(const sem_raycast_scene *s, int part, const double *X, double radius,
+                           double *dist, double *q)
+{
+    int root = s->part_root[part];
+    if (root < 0) return 0;
+    double best = radius, best_q[3] = {0, 0, 0};
+    int best_t = -1;
+    int stack[128], top = 0;
+    stack[top++] = root;
+    while (top > 0) {
+        const part_node *node = &s->part_nodes[stack[--top]];
+        double bd = box_distance2(node, X);
+        if (bd > best * best) continue;
+        if (node->left < 0 || top + 2 > 128) {
+            for (int k = node->first; k < node->first + node->count; k++) {
+                int t = s->part_tri_order[k];
+                const double *v = s->tri + 9 * (size_t)t;
+                double c[3], w[3];
+                closest_point_triangle(X, v, v + 3, v + 6, c);
+                sub3(c, X, w);
+                double dd = sqrt(dot3(w, w));
+                if (dd < best || (dd == best && (best_t < 0 || t < best_t))) {
+                    best = dd;
+                    best_t = t;
+                    memcpy(best_q, c, sizeof c);
+                }
+            }
+            if (node->left >= 0) { /* stack full (never for sane depths): finish exactly */
+                stack[top++] = node->right;
+                stack[top++] = node->left;
+            }
+            continue;
+        }
+        const part_node *L = &s->part_nodes[node->left], *R = &s->part_nodes[node->right];
+        double dl = box_distance2(L, X), dr = box_distance2(R, X);
+        /* push the farther child first so the nearer one is searched first */
+        if (dl <= dr) {
+            stack[top++] = node->right;
+            stack[top++] = node->left;
+        } else {
+            stack[top++] = node->left;
+            stack[top++] = node->right;
+        }
+    }
+    if (best_t < 0) return 0;
+    *dist = best;
+    if (q) memcpy(q, best_q, sizeof best_q);
+    return 1;
+}
+
+int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3], double radius,
+                              int *out_parts, double *out_dist, double *out_points)
+{
+    if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
+        return 0;
+    if (!ensure_part_trees(scene))
+        return closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points);
+    int n = 0;
+    for (int p = 0; p < scene->n_parts; p++) {
+        double d, q[3];
+        if (!closest_in_part(scene, p, X, radius, &d, q)) continue;
+        out_parts[n] = p;
+        out_dist[n] = d;
+        if (out_points) memcpy(out_points + 3 * (size_t)n, q, sizeof q);
+        n++;
+    }
+    return n;
+}
+
 
 /* ---- generalized winding number ---- */
 
@@ -793,9 +1003,9 @@ static int build_winding_tree(sem_raycast_scene *s)
     return 1;
 }
 
-/* The tree is built on the first query (many scenes never need one: rays whose counts are
- * consistent on sealed parts ask no winding number). Thread-safe: one thread builds, the
- * others wait at the critical section. */
+/* The tree is built on the first query, so a scene that is never asked (the weights and the
+ * component search do not need it) does not pay for it. Thread-safe: one thread builds,
+ * the others wait at the critical section. */
 static int ensure_winding_tree(const sem_raycast_scene *scene)
 {
     if (__atomic_load_n(&scene->winding_built, __ATOMIC_ACQUIRE)) return !scene->winding_failed;
@@ -1061,7 +1271,7 @@ static int part_components(const sem_raycast_scene *s, const double *samples,
     for (int p = 0; p < n_parts; p++)
         for (int k = 0; k < n_samples[p]; k++) {
             const double *X = samples + 3 * ((size_t)p * COMPONENT_SAMPLES + (size_t)k);
-            int n = sem_raycast_closest_parts(s, X, tol, found, dist, NULL);
+            int n = closest_parts_embree(s, X, tol, found, dist, NULL);
             for (int i = 0; i < n; i++) {
                 int a = find_root(parent, p), b = find_root(parent, found[i]);
                 if (a != b) parent[a < b ? b : a] = a < b ? a : b;
@@ -1254,7 +1464,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                                                3 * sizeof(unsigned), (size_t)nt);
         if (!vb || !ib) {
             rtcReleaseGeometry(g);
-            free(bsamples);
+                free(bsamples);
             free(n_bsamples);
             sem_raycast_scene_destroy(s);
             return sem_error_set(err, SEM_ERR_NOMEM, "raycast: Embree buffer allocation failed");
@@ -1311,6 +1521,9 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->winding_nodes);
     free(scene->winding_order);
     free(scene->winding_sign);
+    free(scene->part_nodes);
+    free(scene->part_root);
+    free(scene->part_tri_order);
     if (scene->surfaces)
         for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);
     free(scene->surfaces);

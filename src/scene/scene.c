@@ -338,6 +338,76 @@ static sem_status parse_int_list(ctx *c, const cJSON *v, const char *where, int 
     return SEM_OK;
 }
 
+/* "affine" or "rotate" of a prescription object (keys checked by the caller). */
+static sem_status parse_prescription(ctx *c, const cJSON *pr, const char *w, sem_prescribe *out)
+{
+    sem_status st;
+        const cJSON *af = cJSON_GetObjectItemCaseSensitive(pr, "affine");
+        const cJSON *ro = cJSON_GetObjectItemCaseSensitive(pr, "rotate");
+        if (af && ro) return fail(c, w, "give either \"affine\" or \"rotate\", not both");
+        char w2[300];
+        if (af) {
+            snprintf(w2, sizeof w2, "%s.affine", w);
+            if (!cJSON_IsArray(af) || cJSON_GetArraySize(af) != 3) return fail(c, w2, "must be 3 rows of 4 numbers");
+            for (int r = 0; r < 3; ++r) {
+                char wr[320];
+                snprintf(wr, sizeof wr, "%s[%d]", w2, r);
+                if ((st = vec_n(c, cJSON_GetArrayItem(af, r), wr, 4, out->affine + 4 * r)) != SEM_OK)
+                    return st;
+            }
+            out->type = SEM_PRESCRIBE_AFFINE;
+        }
+        if (ro) {
+            static const char *const rkeys[] = {"axis_point", "axis", "degrees_per_second",
+                                                "radians_per_second", "duration", NULL};
+            snprintf(w2, sizeof w2, "%s.rotate", w);
+            if ((st = check_keys(c, ro, w2, rkeys)) != SEM_OK) return st;
+            out->type = SEM_PRESCRIBE_ROTATE;
+            out->axis_direction[0] = 1;
+            if ((st = get_vec(c, ro, "axis_point", w2, 3, out->axis_point)) != SEM_OK) return st;
+            if ((st = get_vec(c, ro, "axis", w2, 3, out->axis_direction)) != SEM_OK) return st;
+            double dps = 0, rps = 0;
+            if ((st = get_number(c, ro, "degrees_per_second", w2, &dps)) != SEM_OK) return st;
+            if ((st = get_number(c, ro, "radians_per_second", w2, &rps)) != SEM_OK) return st;
+            if (cJSON_GetObjectItemCaseSensitive(ro, "degrees_per_second") &&
+                cJSON_GetObjectItemCaseSensitive(ro, "radians_per_second"))
+                return fail(c, w2, "give either \"degrees_per_second\" or \"radians_per_second\", not both");
+            out->rate = rps != 0 ? rps : dps * M_PI / 180.0;
+            if ((st = get_number(c, ro, "duration", w2, &out->duration)) != SEM_OK) return st;
+            const double *a = out->axis_direction;
+            if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] > 0)) return fail(c, w2, "axis must not be zero");
+        }
+        return SEM_OK;
+}
+
+/* A control point selection {box, parts, points}. */
+static sem_status parse_selection(ctx *c, const cJSON *pin, const char *w, int *has_box, double box[6],
+                                  int **parts, int *n_parts, int **points, int *n_points)
+{
+    static const char *const pkeys[] = {"box", "parts", "points", NULL};
+    sem_status st = check_keys(c, pin, w, pkeys);
+    if (st != SEM_OK) return st;
+    char w2[320];
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(pin, "box");
+    if (b) {
+        snprintf(w2, sizeof w2, "%s.box", w);
+        if ((st = get_box(c, b, w2, box)) != SEM_OK) return st;
+        *has_box = 1;
+    }
+    const cJSON *pp = cJSON_GetObjectItemCaseSensitive(pin, "parts");
+    if (pp) {
+        snprintf(w2, sizeof w2, "%s.parts", w);
+        if ((st = parse_int_list(c, pp, w2, parts, n_parts)) != SEM_OK) return st;
+    }
+    const cJSON *pt = cJSON_GetObjectItemCaseSensitive(pin, "points");
+    if (pt) {
+        snprintf(w2, sizeof w2, "%s.points", w);
+        if ((st = parse_int_list(c, pt, w2, points, n_points)) != SEM_OK) return st;
+    }
+    if (!b && !pp && !pt) return fail(c, w, "selects nothing (give box, parts or points)");
+    return SEM_OK;
+}
+
 static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *base_dir,
                                sem_scene_object *obj)
 {
@@ -497,45 +567,35 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         }
     }
     const cJSON *pr = cJSON_GetObjectItemCaseSensitive(o, "prescribe");
-    if (pr) {
+    if (pr && cJSON_IsArray(pr)) {
+        /* several groups, each with its own pin selection and motion */
+        snprintf(w, sizeof w, "%s.prescribe", where);
+        int n = cJSON_GetArraySize(pr);
+        if (n == 0) return fail(c, w, "must not be empty");
+        obj->prescribe_groups = calloc((size_t)n, sizeof *obj->prescribe_groups);
+        if (!obj->prescribe_groups) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+        int k = 0;
+        for (const cJSON *it = pr->child; it; it = it->next, ++k) {
+            static const char *const gkeys[] = {"pin", "affine", "rotate", NULL};
+            char w2[300], w3[320];
+            snprintf(w2, sizeof w2, "%s[%d]", w, k);
+            if ((st = check_keys(c, it, w2, gkeys)) != SEM_OK) return st;
+            sem_scene_prescribe_group *gr = &obj->prescribe_groups[k];
+            obj->n_prescribe_groups = k + 1;
+            const cJSON *gp = cJSON_GetObjectItemCaseSensitive(it, "pin");
+            if (!gp) return fail(c, w2, "needs \"pin\" (which control points follow this motion)");
+            snprintf(w3, sizeof w3, "%s.pin", w2);
+            if ((st = parse_selection(c, gp, w3, &gr->has_box, gr->box, &gr->parts, &gr->n_parts, &gr->points,
+                                      &gr->n_points)) != SEM_OK)
+                return st;
+            if ((st = parse_prescription(c, it, w2, &gr->prescribe)) != SEM_OK) return st;
+            if (gr->prescribe.type == SEM_PRESCRIBE_NONE) return fail(c, w2, "needs \"affine\" or \"rotate\"");
+        }
+    } else if (pr) {
         static const char *const pkeys[] = {"affine", "rotate", NULL};
         snprintf(w, sizeof w, "%s.prescribe", where);
         if ((st = check_keys(c, pr, w, pkeys)) != SEM_OK) return st;
-        const cJSON *af = cJSON_GetObjectItemCaseSensitive(pr, "affine");
-        const cJSON *ro = cJSON_GetObjectItemCaseSensitive(pr, "rotate");
-        if (af && ro) return fail(c, w, "give either \"affine\" or \"rotate\", not both");
-        char w2[300];
-        if (af) {
-            snprintf(w2, sizeof w2, "%s.affine", w);
-            if (!cJSON_IsArray(af) || cJSON_GetArraySize(af) != 3) return fail(c, w2, "must be 3 rows of 4 numbers");
-            for (int r = 0; r < 3; ++r) {
-                char wr[320];
-                snprintf(wr, sizeof wr, "%s[%d]", w2, r);
-                if ((st = vec_n(c, cJSON_GetArrayItem(af, r), wr, 4, obj->prescribe.affine + 4 * r)) != SEM_OK)
-                    return st;
-            }
-            obj->prescribe.type = SEM_PRESCRIBE_AFFINE;
-        }
-        if (ro) {
-            static const char *const rkeys[] = {"axis_point", "axis", "degrees_per_second",
-                                                "radians_per_second", "duration", NULL};
-            snprintf(w2, sizeof w2, "%s.rotate", w);
-            if ((st = check_keys(c, ro, w2, rkeys)) != SEM_OK) return st;
-            obj->prescribe.type = SEM_PRESCRIBE_ROTATE;
-            obj->prescribe.axis_direction[0] = 1;
-            if ((st = get_vec(c, ro, "axis_point", w2, 3, obj->prescribe.axis_point)) != SEM_OK) return st;
-            if ((st = get_vec(c, ro, "axis", w2, 3, obj->prescribe.axis_direction)) != SEM_OK) return st;
-            double dps = 0, rps = 0;
-            if ((st = get_number(c, ro, "degrees_per_second", w2, &dps)) != SEM_OK) return st;
-            if ((st = get_number(c, ro, "radians_per_second", w2, &rps)) != SEM_OK) return st;
-            if (cJSON_GetObjectItemCaseSensitive(ro, "degrees_per_second") &&
-                cJSON_GetObjectItemCaseSensitive(ro, "radians_per_second"))
-                return fail(c, w2, "give either \"degrees_per_second\" or \"radians_per_second\", not both");
-            obj->prescribe.rate = rps != 0 ? rps : dps * M_PI / 180.0;
-            if ((st = get_number(c, ro, "duration", w2, &obj->prescribe.duration)) != SEM_OK) return st;
-            const double *a = obj->prescribe.axis_direction;
-            if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] > 0)) return fail(c, w2, "axis must not be zero");
-        }
+        if ((st = parse_prescription(c, pr, w, &obj->prescribe)) != SEM_OK) return st;
     }
     if (obj->prescribe.type != SEM_PRESCRIBE_NONE && !obj->has_pin_box && obj->n_pin_parts == 0 &&
         obj->n_pin_points == 0) {
@@ -686,6 +746,11 @@ static void object_free(sem_scene_object *o)
     free(o->pin_points);
     free(o->point_loads);
     free(o->region_loads);
+    for (int k = 0; k < o->n_prescribe_groups; ++k) {
+        free(o->prescribe_groups[k].parts);
+        free(o->prescribe_groups[k].points);
+    }
+    free(o->prescribe_groups);
 }
 
 void sem_scene_destroy(sem_scene *s)
@@ -972,5 +1037,67 @@ sem_status sem_scene_object_part_materials(const sem_scene_object *o, const sem_
     }
     *out = idx;
     *materials = mats;
+    return SEM_OK;
+}
+
+sem_status sem_scene_object_prescribe_groups(const sem_scene_object *o, const sem_model *m, int **out,
+                                             sem_error *err)
+{
+    *out = NULL;
+    if (o->n_prescribe_groups == 0) return SEM_OK;
+    size_t n = sem_model_control_points(m);
+    int *group = malloc((n + 1) * sizeof(int));
+    size_t *off = malloc(((size_t)m->n_parts + 1) * sizeof(size_t));
+    if (!group || !off) {
+        free(group);
+        free(off);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (size_t c = 0; c < n; ++c) group[c] = -1;
+    sem_model_part_offsets(m, off);
+    for (int g = 0; g < o->n_prescribe_groups; ++g) {
+        const sem_scene_prescribe_group *gr = &o->prescribe_groups[g];
+        size_t count = 0;
+        for (int k = 0; k < gr->n_parts; ++k)
+            if (gr->parts[k] >= m->n_parts) {
+                free(group);
+                free(off);
+                return sem_error_set(err, SEM_ERR_INVALID, "prescribe[%d].pin.parts: part %d does not exist (model has %d parts)",
+                                     g, gr->parts[k], m->n_parts);
+            }
+        for (int k = 0; k < gr->n_points; ++k)
+            if ((size_t)gr->points[k] >= n) {
+                free(group);
+                free(off);
+                return sem_error_set(err, SEM_ERR_INVALID,
+                                     "prescribe[%d].pin.points: control point %d does not exist (model has %zu)", g,
+                                     gr->points[k], n);
+            }
+        for (int i = 0; i < m->n_parts; ++i) {
+            const sem_surface *s = &m->parts[i].surface;
+            int whole = 0;
+            for (int k = 0; k < gr->n_parts; ++k) whole |= gr->parts[k] == i;
+            for (int c = 0; c < s->n_u * s->n_v; ++c) {
+                const double *x = s->ctrl + 3 * c;
+                int in = gr->has_box && x[0] >= gr->box[0] && x[1] >= gr->box[1] && x[2] >= gr->box[2] &&
+                         x[0] <= gr->box[3] && x[1] <= gr->box[4] && x[2] <= gr->box[5];
+                if (in || whole) {
+                    group[off[i] + (size_t)c] = g;
+                    count++;
+                }
+            }
+        }
+        for (int k = 0; k < gr->n_points; ++k) {
+            group[gr->points[k]] = g;
+            count++;
+        }
+        if (count == 0) {
+            free(group);
+            free(off);
+            return sem_error_set(err, SEM_ERR_INVALID, "prescribe[%d].pin: selects no control point of the model", g);
+        }
+    }
+    free(off);
+    *out = group;
     return SEM_OK;
 }
