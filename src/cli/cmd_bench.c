@@ -160,7 +160,7 @@ int cmd_bench(int argc, char **argv)
             continue;
         }
         fprintf(stderr, "sem bench: [%d/%d] %s (%s)...\n", k + 1, sem_table1_count, r->example, r->file);
-        bench_result b;
+        bench_result b = {0, 0, 0, 0, 0, 0, 0, 0, "none"};
         sem_error err;
         sem_error_clear(&err);
         double t0 = omp_get_wtime();
