@@ -39,6 +39,13 @@ void sem_surface_eval(const sem_surface *s, double u, double v, double point[3],
 int sem_surface_basis(const sem_surface *s, double u, double v, int *index, double *phi,
                       double *phi_u, double *phi_v);
 
+/* The same row from precomputed spans and non-rational basis values (Nu, Nv as written by
+ * sem_bspline_basis with at least one derivative when phi_u or phi_v is wanted): for
+ * callers that evaluate many points on one grid of (u, v) values. */
+int sem_surface_basis_from_spans(const sem_surface *s, int su, const double *Nu, int sv,
+                                 const double *Nv, int *index, double *phi, double *phi_u,
+                                 double *phi_v);
+
 /* Unit normal (x_u x x_v normalised); at a collapsed edge it falls back to a nearby
  * non-degenerate direction. Returns |x_u x x_v| at (u,v) (area element). */
 double sem_surface_normal(const sem_surface *s, double u, double v, double normal[3]);

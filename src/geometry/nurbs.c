@@ -174,6 +174,15 @@ int sem_surface_basis(const sem_surface *s, double u, double v, int *index, doub
     int sv = sem_bspline_span(pv, s->n_v, s->knots_v, v);
     sem_bspline_basis(pu, s->knots_u, su, u, nd, Nu);
     sem_bspline_basis(pv, s->knots_v, sv, v, nd, Nv);
+    return sem_surface_basis_from_spans(s, su, Nu, sv, Nv, index, phi, phi_u, phi_v);
+}
+
+int sem_surface_basis_from_spans(const sem_surface *s, int su, const double *Nu, int sv,
+                                 const double *Nv, int *index, double *phi, double *phi_u,
+                                 double *phi_v)
+{
+    const int pu = s->degree_u, pv = s->degree_v;
+    int nd = (phi_u || phi_v) ? 1 : 0;
     double W = 0, Wu = 0, Wv = 0;
     int n = 0;
     for (int l = 0; l <= pv; ++l) {

@@ -208,42 +208,6 @@ static void direction_basis_free(direction_basis *b)
     free(b->N);
 }
 
-/* The rational basis row of sem_surface_basis (same arithmetic, same order, so the
- * results are bitwise equal) from cached non-rational values. */
-static int basis_row(const sem_surface *s, int su, const double *Nu, int sv, const double *Nv,
-                     int *index, double *phi, double *phi_u, double *phi_v)
-{
-    const int pu = s->degree_u, pv = s->degree_v;
-    double W = 0, Wu = 0, Wv = 0;
-    int n = 0;
-    for (int l = 0; l <= pv; ++l) {
-        int j = sv - pv + l;
-        for (int k = 0; k <= pu; ++k) {
-            int i = su - pu + k;
-            int idx = i + s->n_u * j;
-            double w = s->weights[idx];
-            double b = w * Nu[k] * Nv[l];
-            index[n] = idx;
-            phi[n] = b;
-            W += b;
-            double bu = w * Nu[(pu + 1) + k] * Nv[l];
-            double bv = w * Nu[k] * Nv[(pv + 1) + l];
-            phi_u[n] = bu;
-            phi_v[n] = bv;
-            Wu += bu;
-            Wv += bv;
-            ++n;
-        }
-    }
-    for (int k = 0; k < n; ++k) {
-        double b = phi[k];
-        phi[k] = b / W;
-        phi_u[k] = (phi_u[k] - phi[k] * Wu) / W;
-        phi_v[k] = (phi_v[k] - phi[k] * Wv) / W;
-    }
-    return n;
-}
-
 /* Position and unit normal from a basis row (the per-frame update's arithmetic). */
 static void vertex_frame(const sem_surface *s, int n_basis, const int *index, const double *phi,
                          const double *phi_u, const double *phi_v, double u, double v,
@@ -387,12 +351,12 @@ static int evaluate_part(const sem_mesh_template *t, const sem_model *model, int
             const double *Nv = bv.N + (size_t)iv * (size_t)sv_len;
             size_t vtx = (size_t)pt->first_vertex + (size_t)k;
             if (m) {
-                basis_row(s, bu.span[iu], Nu, bv.span[iv], Nv, index, phi, phi + nb, phi + 2 * nb);
+                sem_surface_basis_from_spans(s, bu.span[iu], Nu, bv.span[iv], Nv, index, phi, phi + nb, phi + 2 * nb);
                 vertex_frame(s, nb, index, phi, phi + nb, phi + 2 * nb, p->us[iu], p->vs[iv],
                              m->positions + 3 * vtx, m->normals + 3 * vtx);
             } else {
                 size_t off = pt->basis_offset + (size_t)k * (size_t)nb;
-                basis_row(s, bu.span[iu], Nu, bv.span[iv], Nv, t->basis_index + off, t->phi + off,
+                sem_surface_basis_from_spans(s, bu.span[iu], Nu, bv.span[iv], Nv, t->basis_index + off, t->phi + off,
                           t->phi_u + off, t->phi_v + off);
             }
         }
