@@ -51,10 +51,10 @@ static sem_preprocess_options fast_options(void)
 static void test_defaults(void)
 {
     sem_preprocess_options o = sem_default_preprocess_options();
-    CHECK(o.order == 2 && o.rays[0] == 10 && o.rays[1] == 10 && o.ray_axis == 0, "defaults");
-    CHECK(o.points_per_interval == 5 && o.alpha == 0 && o.sparsity == 0, "defaults");
+    CHECK(o.order == 2 && o.rays[0] == 40 && o.rays[1] == 40 && o.ray_axis == 0, "defaults");
+    CHECK(o.points_per_interval == 2 && o.alpha == 0 && o.sparsity == 0, "defaults");
     CHECK(o.weight_threshold == 1e-4 && o.gamma == 0 && o.youngs_modulus == 1e6, "defaults");
-    CHECK(o.tessellation == 8 && o.threads == 0, "defaults");
+    CHECK(o.tessellation == 16 && o.threads == 0, "defaults");
 
     double b[10], db[30], dX[3] = {0.5, -2.0, 3.0};
     sem_polynomial_basis(2, dX, b, db);
@@ -312,7 +312,7 @@ static void test_save_load(void)
     memcpy(data + 8, &version, 4);
     write_bytes(bad, data, (size_t)size);
     st = sem_discretization_load(bad, 0, &e, &err);
-    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 1"),
+    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 2"),
           "version message: %s", err.message);
     memcpy(data, "NOTSEM!!", 8);
     write_bytes(bad, data, (size_t)size);

@@ -24,7 +24,8 @@
  * planar parts and for parts lying on a quadric through the origin. We detect this from the
  * eigenvalues of the small (3 x 3 or 6 x 6) normal matrix N_i, computed after scaling dX by
  * the group's sample spread L_j (so N is O(1) and the threshold is scale free): directions
- * with eigenvalue <= 1e-10 x the largest are "null" directions Z of the part.
+ * with eigenvalue <= 1e-8 x the largest are "null" directions Z of the part (1e-8: a nearly
+ * flat part then amplifies round-off by at most ~1e8, so the patch test stays exact to ~1e-8).
  * In the null directions the coefficients are taken from the group's fit: with N_G and
  * rhs_G the same normal matrix and right-hand side assembled over the samples of all parts
  * of origin j (part i included, residuals taken against part i's lower-order fit),
@@ -59,7 +60,7 @@
 #include "steps.h"
 
 /* Relative eigenvalue threshold below which a fit direction counts as undetermined. */
-#define SEM_PROJECTION_NULL_TOL 1e-10
+#define SEM_PROJECTION_NULL_TOL 1e-8
 /* Relative tolerance on |Xbar_j - rest centroid of group j| (see the opening comment). */
 #define SEM_PROJECTION_ORIGIN_TOL 1e-9
 
