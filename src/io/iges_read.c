@@ -380,7 +380,7 @@ static int parse_real(const char *s, int len, double def, double *out)
         return 1;
     }
     char buf[96];
-    if (len >= (int)sizeof buf) return 0;
+    if (len < 0 || len >= (int)sizeof buf) return 0;
     int digits = 0;
     for (int i = 0; i < len; ++i) {
         char c = s[i];
