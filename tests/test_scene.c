@@ -470,7 +470,7 @@ static void test_default_scene(void)
     if (!s) return;
     CHECK(s->n_objects == 1 && !strcmp(s->objects[0].primitive, "beam"), "beam");
     CHECK(s->world.integrator == SEM_IMPLICIT_EULER && s->frames == 100 && s->steps_per_frame == 2, "world");
-    CHECK_NEAR(s->objects[0].material.youngs_modulus, 3e5, 0);
+    CHECK_NEAR(s->objects[0].material.youngs_modulus, 2e6, 0);
     sem_scene_destroy(s);
     /* examples/default_beam.json is the same scene */
     char path[1024];
@@ -479,7 +479,7 @@ static void test_default_scene(void)
     if (s) {
         CHECK(s->world.integrator == SEM_IMPLICIT_EULER && s->frames == 100 && s->steps_per_frame == 2, "world");
         CHECK(s->objects[0].primitive_sections == 4 && s->objects[0].primitive_size[0] == 2, "beam");
-        CHECK_NEAR(s->objects[0].material.youngs_modulus, 3e5, 0);
+        CHECK_NEAR(s->objects[0].material.youngs_modulus, 2e6, 0);
         CHECK_NEAR(s->objects[0].material.density, 1100, 0);
         CHECK(s->objects[0].has_pin_box && s->objects[0].pin_box[3] == 0.01, "pin");
         sem_scene_destroy(s);

@@ -35,8 +35,8 @@ typedef struct sem_preprocess_options {
     int points_per_interval; /* volume points per inside interval; default 2 */
     double alpha;            /* weight cut-off distance, model units; <= 0: use sparsity */
     double sparsity;         /* target non-zero fraction T in (0,1) when alpha <= 0;
-                                when both are unset (alpha 0, sparsity 0): alpha = 0.5 x
-                                the bounding-box diagonal */
+                                when both are unset (alpha 0, sparsity 0): alpha = half
+                                the median part size (its samples' bbox diagonal) */
     double weight_threshold; /* weights below are dropped; default 1e-4 */
     double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
     double youngs_modulus;   /* for the default gamma; default 1e6 */
