@@ -60,6 +60,7 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     po.rays[0] = r->rays[0];
     po.rays[1] = r->rays[1];
     po.points_per_interval = r->points_per_interval;
+    po.tessellation = 8; /* ray-cast triangulation as in bench/bench_preprocess.c (not an authors' setting) */
     po.alpha = r->alpha;
     po.youngs_modulus = r->youngs_modulus;
     sem_discretization *d = NULL;
