@@ -228,7 +228,7 @@ static void test_fast_winding(void)
     sem_raycast_scene *scene = NULL;
     CHECK(sem_raycast_scene_build(m, 16, &scene, &err) == SEM_OK, "build: %s", err.message);
     if (scene) {
-        double worst = 0;
+        double worst = 0, worst_coarse = 0;
         unsigned seed = 12345;
         for (int k = 0; k < 400; k++) {
             double X[3];
@@ -240,11 +240,17 @@ static void test_fast_winding(void)
             if (fabs(r - 1) < 0.05 || fabs(X[0] - 2) < 0.05) continue;
             double fast = sem_raycast_winding_number(scene, X);
             double exact = sem_raycast_winding_number_exact(scene, X);
+            double coarse = sem_raycast_winding_number_coarse(scene, X);
             if (fabs(fast - exact) > worst) worst = fabs(fast - exact);
+            if (fabs(coarse - exact) > worst_coarse) worst_coarse = fabs(coarse - exact);
             if (r < 0.95) CHECK(fabs(exact - 1) < 0.2 || fabs(X[0] - 2) < 1, "inside %g", exact);
         }
         printf("fast winding number: worst difference %.3g\n", worst);
         CHECK(worst < 5e-3, "fast vs exact winding number %g", worst);
+        /* the coarse far field decides the quadrature's veto (threshold 1/4 between values
+         * ~0 and ~1): it must stay well inside that margin */
+        printf("coarse winding number: worst difference %.3g\n", worst_coarse);
+        CHECK(worst_coarse < 0.1, "coarse vs exact winding number %g", worst_coarse);
         const double c[3] = {0, 0, 0};
         CHECK_NEAR(sem_raycast_winding_number_exact(scene, c) -
                        sem_raycast_winding_number(scene, c), 0.0, 5e-3);

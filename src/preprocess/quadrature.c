@@ -162,7 +162,7 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
             if (!seg[i].inside || !(seg[i].t1 > seg[i].t0)) continue;
             double tm = 0.5 * (seg[i].t0 + seg[i].t1), X[3];
             for (int d = 0; d < 3; d++) X[d] = origin[d] + tm * dir[d];
-            if (sem_raycast_winding_number(scene, X) < WINDING_VETO) seg[i].inside = 0;
+            if (sem_raycast_winding_number_coarse(scene, X) < WINDING_VETO) seg[i].inside = 0;
         }
     }
 
@@ -258,7 +258,8 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     int failed = 0;
     int ppi = o->points_per_interval;
-#pragma omp parallel for schedule(dynamic, 4) reduction(| : failed)
+    /* waking a second thread costs more than a few hundred rays of work on small grids */
+#pragma omp parallel for schedule(dynamic, 4) reduction(| : failed) if (n_rays >= 256)
     for (int r = 0; r < n_rays; r++) {
         int i = r % n1, j = r / n1;
         double origin[3], dir[3] = {0, 0, 0};

@@ -886,6 +886,9 @@ double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const do
  * (test_raycast), far below what the 1/2 threshold needs, and the castle's quadrature
  * drops from 0.42 s (exact) to 0.013 s. */
 #define WINDING_BETA 6.0
+/* For yes/no decisions far from the threshold (the quadrature's veto: ~1 inside against
+ * < 1/4), a first-order far field from 2 radii is plenty and opens far fewer nodes. */
+#define WINDING_BETA_COARSE 2.0
 #define WINDING_LEAF 8
 
 typedef struct winding_node {
@@ -1020,7 +1023,19 @@ static int ensure_winding_tree(const sem_raycast_scene *scene)
     return !scene->winding_failed;
 }
 
+static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta);
+
 double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
+{
+    return winding_number_beta(scene, X, WINDING_BETA);
+}
+
+double sem_raycast_winding_number_coarse(const sem_raycast_scene *scene, const double X[3])
+{
+    return winding_number_beta(scene, X, WINDING_BETA_COARSE);
+}
+
+static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta)
 {
     if (!scene || !X) return 0.0;
     if (!ensure_winding_tree(scene) || !scene->winding_nodes)
@@ -1034,7 +1049,7 @@ double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X
         double w[3];
         sub3(node->p, X, w);
         double d2 = dot3(w, w);
-        if (d2 > WINDING_BETA * WINDING_BETA * node->radius * node->radius) {
+        if (d2 > beta * beta * node->radius * node->radius) {
             total += dot3(node->N, w) / (d2 * sqrt(d2)); /* dipole: solid angle */
         } else if (node->left < 0 || top + 2 > 128) {
             for (int k = node->first; k < node->first + node->count; k++) {
@@ -1293,6 +1308,8 @@ static void embree_error(void *user, enum RTCError code, const char *str)
     (void)str; /* reported through rtcGetDeviceError where it matters */
 }
 
+static int ensure_winding_tree(const sem_raycast_scene *scene);
+
 sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                                    sem_raycast_scene **out, sem_error *err)
 {
@@ -1503,6 +1520,9 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
     free(sign);
     free(component);
+    /* the winding-number tree depends on the corrected signs; the quadrature queries it for
+     * every inside segment, so it is part of preparing the scene */
+    ensure_winding_tree(s);
     *out = s;
     return SEM_OK;
 }
