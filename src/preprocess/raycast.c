@@ -658,6 +658,36 @@ typedef struct part_node {
     int first, count; /* leaf: range in part_tri_order */
 } part_node;
 
+/* Reorders the triangle indices o[0..count) so that o[count / 2] has the median centroid
+ * along axis, smaller ones before it and larger ones after (quickselect): the split of both
+ * bounding-volume trees below. */
+static void select_median(int *o, int count, const double *centroid, int axis)
+{
+    int half = count / 2;
+    int l = 0, r = count - 1;
+    while (l < r) {
+        double pivot = centroid[3 * (size_t)o[(l + r) / 2] + axis];
+        int i = l, j = r;
+        while (i <= j) {
+            while (centroid[3 * (size_t)o[i] + axis] < pivot) i++;
+            while (centroid[3 * (size_t)o[j] + axis] > pivot) j--;
+            if (i <= j) {
+                int tmp = o[i];
+                o[i] = o[j];
+                o[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (half <= j)
+            r = j;
+        else if (half >= i)
+            l = i;
+        else
+            break;
+    }
+}
+
 static int build_part_node(sem_raycast_scene *s, const double *centroid, int *n_nodes, int first,
                            int count)
 {
@@ -690,28 +720,7 @@ static int build_part_node(sem_raycast_scene *s, const double *centroid, int *n_
     for (int d = 1; d < 3; d++)
         if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
     int half = count / 2;
-    int l = 0, r = count - 1; /* quickselect the median centroid on the axis */
-    while (l < r) {
-        double pivot = centroid[3 * (size_t)o[(l + r) / 2] + axis];
-        int i = l, j = r;
-        while (i <= j) {
-            while (centroid[3 * (size_t)o[i] + axis] < pivot) i++;
-            while (centroid[3 * (size_t)o[j] + axis] > pivot) j--;
-            if (i <= j) {
-                int tmp = o[i];
-                o[i] = o[j];
-                o[j] = tmp;
-                i++;
-                j--;
-            }
-        }
-        if (half <= j)
-            r = j;
-        else if (half >= i)
-            l = i;
-        else
-            break;
-    }
+    select_median(o, count, centroid, axis);
     int left = build_part_node(s, centroid, n_nodes, first, half);
     int right = build_part_node(s, centroid, n_nodes, first + half, count - half);
     s->part_nodes[id].left = left;
@@ -944,29 +953,7 @@ static int build_winding_node(sem_raycast_scene *s, double *centroid, int first,
         if (hi[d] - lo[d] > hi[axis] - lo[axis]) axis = d;
     int half = count / 2;
     int *o = s->winding_order + first;
-    /* quickselect on centroid[axis] */
-    int l = 0, r = count - 1;
-    while (l < r) {
-        double pivot = centroid[3 * (size_t)o[(l + r) / 2] + axis];
-        int i = l, j = r;
-        while (i <= j) {
-            while (centroid[3 * (size_t)o[i] + axis] < pivot) i++;
-            while (centroid[3 * (size_t)o[j] + axis] > pivot) j--;
-            if (i <= j) {
-                int tmp = o[i];
-                o[i] = o[j];
-                o[j] = tmp;
-                i++;
-                j--;
-            }
-        }
-        if (half <= j)
-            r = j;
-        else if (half >= i)
-            l = i;
-        else
-            break;
-    }
+    select_median(o, count, centroid, axis);
     int left = build_winding_node(s, centroid, first, half);
     int right = build_winding_node(s, centroid, first + half, count - half);
     s->winding_nodes[id].left = left;
