@@ -57,7 +57,8 @@
  *   Collision Detection, 5.1.5), minimum per part within the radius. The public query walks
  *   a small box tree per part (built on first use) with a radius that shrinks to the best
  *   distance so far; the component search at scene build uses one Embree rtcPointQuery
- *   (its radius is tiny). The winding-number tree is also built on first use.
+ *   (its radius is tiny). The winding-number tree is built with the scene (after the
+ *   orientation fix), since the quadrature queries it for every inside segment.
  * - Orientation votes stop as soon as the votes not cast yet cannot change the sign.
  */
 #include "raycast.h"
@@ -165,7 +166,6 @@ struct sem_raycast_scene {
     int n_winding_nodes;
     int *winding_order;       /* triangle indices in tree order */
     signed char *winding_sign; /* part_sign of each triangle */
-    int winding_built;        /* set (atomically) once the tree above exists */
     int winding_failed;       /* out of memory while building it: exact sums instead */
     /* per-part bounding-volume trees for closest-point queries (built on first use) */
     struct part_node *part_nodes;
@@ -993,23 +993,6 @@ static int build_winding_tree(sem_raycast_scene *s)
     return 1;
 }
 
-/* The tree is built on the first query, so a scene that is never asked (the weights and the
- * component search do not need it) does not pay for it. Thread-safe: one thread builds,
- * the others wait at the critical section. */
-static int ensure_winding_tree(const sem_raycast_scene *scene)
-{
-    if (__atomic_load_n(&scene->winding_built, __ATOMIC_ACQUIRE)) return !scene->winding_failed;
-    sem_raycast_scene *s = (sem_raycast_scene *)scene; /* lazily filled cache */
-#pragma omp critical(sem_raycast_winding)
-    {
-        if (!__atomic_load_n(&s->winding_built, __ATOMIC_ACQUIRE)) {
-            s->winding_failed = !build_winding_tree(s);
-            __atomic_store_n(&s->winding_built, 1, __ATOMIC_RELEASE);
-        }
-    }
-    return !scene->winding_failed;
-}
-
 static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta);
 
 double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
@@ -1025,7 +1008,7 @@ double sem_raycast_winding_number_coarse(const sem_raycast_scene *scene, const d
 static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta)
 {
     if (!scene || !X) return 0.0;
-    if (!ensure_winding_tree(scene) || !scene->winding_nodes)
+    if (scene->winding_failed || !scene->winding_nodes)
         return sem_raycast_winding_number_exact(scene, X);
     int stack[128];
     int top = 0;
@@ -1295,8 +1278,6 @@ static void embree_error(void *user, enum RTCError code, const char *str)
     (void)str; /* reported through rtcGetDeviceError where it matters */
 }
 
-static int ensure_winding_tree(const sem_raycast_scene *scene);
-
 sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                                    sem_raycast_scene **out, sem_error *err)
 {
@@ -1508,8 +1489,9 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     free(sign);
     free(component);
     /* the winding-number tree depends on the corrected signs; the quadrature queries it for
-     * every inside segment, so it is part of preparing the scene */
-    ensure_winding_tree(s);
+     * every inside segment, so it is part of preparing the scene (out of memory: the
+     * queries fall back to exact sums) */
+    s->winding_failed = !build_winding_tree(s);
     *out = s;
     return SEM_OK;
 }
