@@ -166,6 +166,7 @@ struct sem_raycast_scene {
     int n_winding_nodes;
     int *winding_order;       /* triangle indices in tree order */
     signed char *winding_sign; /* part_sign of each triangle */
+    struct winding_tri *winding_tris; /* the triangles in tree order, orientation-corrected */
     int winding_failed;       /* out of memory while building it: exact sums instead */
     /* per-part bounding-volume trees for closest-point queries (built on first use) */
     struct part_node *part_nodes;
@@ -900,6 +901,20 @@ double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const do
 #define WINDING_BETA_COARSE 2.0
 #define WINDING_LEAF 8
 
+/* A leaf triangle as the winding number reads it: vertices in corrected order (v1 and v2
+ * swapped when the part's sign is -1, which negates the solid angle), the area-weighted
+ * corrected normal and centroid of its own dipole, and its squared radius about the
+ * centroid. A leaf triangle seen from beyond beta radii is summed as a dipole too, by the
+ * same rule as a node: near a thin solid most of a leaf's triangles are far even when the
+ * leaf is not, and the dipole costs one square root against the solid angle's three and
+ * an atan2. Contiguous, so a leaf is one cache-friendly run. */
+typedef struct winding_tri {
+    double v[9];
+    double c[3];
+    double an[3];
+    double r2;
+} winding_tri;
+
 typedef struct winding_node {
     double p[3];       /* area-weighted centroid */
     double N[3];       /* sum of area x corrected unit normal */
@@ -989,6 +1004,32 @@ static int build_winding_tree(sem_raycast_scene *s)
     }
     s->n_winding_nodes = 0;
     build_winding_node(s, centroid, 0, n);
+    s->winding_tris = malloc((size_t)(n > 0 ? n : 1) * sizeof *s->winding_tris);
+    if (!s->winding_tris) {
+        free(centroid);
+        return 0;
+    }
+    for (int k = 0; k < n; k++) {
+        int t = s->winding_order[k];
+        winding_tri *wt = &s->winding_tris[k];
+        const double *v = s->tri + 9 * (size_t)t;
+        int sg = s->winding_sign[t];
+        memcpy(wt->v, v, 3 * sizeof *v);
+        memcpy(wt->v + 3, sg > 0 ? v + 3 : v + 6, 3 * sizeof *v);
+        memcpy(wt->v + 6, sg > 0 ? v + 6 : v + 3, 3 * sizeof *v);
+        double r2 = 0;
+        for (int d = 0; d < 3; d++) {
+            wt->c[d] = centroid[3 * (size_t)t + d];
+            wt->an[d] = sg * s->tri_area[t] * s->tri_normal[3 * (size_t)t + d];
+        }
+        for (int c = 0; c < 3; c++) {
+            double w[3];
+            sub3(v + 3 * c, wt->c, w);
+            double q = dot3(w, w);
+            if (q > r2) r2 = q;
+        }
+        wt->r2 = r2;
+    }
     free(centroid);
     return 1;
 }
@@ -1022,9 +1063,15 @@ static double winding_number_beta(const sem_raycast_scene *scene, const double X
         if (d2 > beta * beta * node->radius * node->radius) {
             total += dot3(node->N, w) / (d2 * sqrt(d2)); /* dipole: solid angle */
         } else if (node->left < 0 || top + 2 > 128) {
-            for (int k = node->first; k < node->first + node->count; k++) {
-                int t = scene->winding_order[k];
-                total += scene->winding_sign[t] * solid_angle(scene->tri + 9 * (size_t)t, X);
+            const winding_tri *wt = scene->winding_tris + node->first;
+            for (int k = 0; k < node->count; k++, wt++) {
+                double u[3];
+                sub3(wt->c, X, u);
+                double e2 = dot3(u, u);
+                if (e2 > beta * beta * wt->r2)
+                    total += dot3(wt->an, u) / (e2 * sqrt(e2));
+                else
+                    total += solid_angle(wt->v, X);
             }
         } else {
             stack[top++] = node->right;
@@ -1510,6 +1557,7 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->winding_nodes);
     free(scene->winding_order);
     free(scene->winding_sign);
+    free(scene->winding_tris);
     free(scene->part_nodes);
     free(scene->part_root);
     free(scene->part_tri_order);
