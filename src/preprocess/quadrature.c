@@ -51,15 +51,6 @@
 
 #define WINDING_INSIDE 0.5 /* fallback: inside when the winding number is above */
 
-/* Is the winding number at X above threshold? The coarse far field (error below 0.06 in
- * test_raycast) decides when it is clearly on one side; only values within 0.15 of the
- * threshold pay for the accurate sum. The decision is the accurate one's either way. */
-static int winding_above(const sem_raycast_scene *scene, const double X[3], double threshold)
-{
-    double w = sem_raycast_winding_number_coarse(scene, X);
-    if (fabs(w - threshold) > 0.15) return w > threshold;
-    return sem_raycast_winding_number(scene, X) > threshold;
-}
 #define WINDING_VETO 0.25  /* consistent counting: outside when the winding number is below */
 
 typedef struct ray_points {
@@ -172,7 +163,7 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
             if (!seg[i].inside || !(seg[i].t1 > seg[i].t0)) continue;
             double tm = 0.5 * (seg[i].t0 + seg[i].t1), X[3];
             for (int d = 0; d < 3; d++) X[d] = origin[d] + tm * dir[d];
-            if (!winding_above(scene, X, WINDING_VETO)) seg[i].inside = 0;
+            if (!sem_raycast_winding_above(scene, X, WINDING_VETO)) seg[i].inside = 0;
         }
     }
 
@@ -189,7 +180,7 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
             if (!(seg[i].t1 > seg[i].t0)) continue;
             double tm = 0.5 * (seg[i].t0 + seg[i].t1), X[3];
             for (int d = 0; d < 3; d++) X[d] = origin[d] + tm * dir[d];
-            seg[i].inside = winding_above(scene, X, WINDING_INSIDE);
+            seg[i].inside = sem_raycast_winding_above(scene, X, WINDING_INSIDE);
         }
     }
 

@@ -48,11 +48,14 @@ int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3],
 /* Generalized winding number (Jacobson et al. 2013) of the orientation-corrected
  * tessellation at X: ~1 inside, ~0 outside, fractional near open boundaries. */
 double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3]);
-/* The same with a far field from 2 node radii (error up to ~0.06 measured): for decisions whose threshold is
- * far from the values that occur, such as the quadrature's veto. */
+/* The same with a second-order far field from 1.5 node radii (error up to ~0.1 measured
+ * on the shared models): for yes/no decisions with a margin, such as the quadrature's. */
 double sem_raycast_winding_number_coarse(const sem_raycast_scene *scene, const double X[3]);
+/* Is the winding number at X above threshold? Decided by the cheapest far field whose
+ * error bound keeps it clear of the threshold (see raycast.c); thread-safe. */
+int sem_raycast_winding_above(const sem_raycast_scene *scene, const double X[3], double threshold);
 /* The same summed exactly over every triangle (O(triangles)); the function above uses
- * Barill et al.'s (2018) tree with a dipole far field (see raycast.c), equal to this
+ * Barill et al.'s (2018) tree with a second-order far field (see raycast.c), equal to this
  * within ~5e-3 away from the surface. */
 double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const double X[3]);
 /* Bounding box of the tessellation: lo[3], hi[3]. */
