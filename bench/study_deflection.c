@@ -11,7 +11,7 @@
  *   --fem FILE      FEM reference (default validation/fem_cantilever.json, also tried
  *                   relative to ..)
  *   --sections LIST comma-separated section counts of generated beams (sem_primitive_beam),
- *                   default 1,2,3,4,5,6,8,10,12,15,20
+ *                   default 1,2,3,4,5,6,8,10,12,15,20,25,30
  *   --gamma G       error stiffness (default: the preprocessing default, kappa E / L)
  *   --material NAME neohookean (default) or any name sem_material_parse_type accepts
  *   --rays N1 N2    ray grid across x (default the authors' 3 x 3)
@@ -56,7 +56,7 @@ static void report(const char *source, int sections, const sem_cantilever_result
 
 int main(int argc, char **argv)
 {
-    const char *dir_arg = NULL, *fem_path = NULL, *sections_arg = "1,2,3,4,5,6,8,10,12,15,20";
+    const char *dir_arg = NULL, *fem_path = NULL, *sections_arg = "1,2,3,4,5,6,8,10,12,15,20,25,30";
     int files = 1, generated = 1;
     sem_cantilever_settings s = sem_default_cantilever_settings();
     for (int i = 1; i < argc; ++i) {

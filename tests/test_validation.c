@@ -2,10 +2,13 @@
  * - the recorded FEM reference (validation/fem_cantilever.json, tools/fem/cantilever.py) is
  *   sane: converged tip deflection in [3.5, 5] m and its linear check within 10 % of
  *   Euler-Bernoulli beam theory;
- * - SEM static deflection of the paper's b1..b4 cantilevers (authors' settings: quadratic,
- *   alpha 0.501, rays 3 x 3, 100 points per interval, gamma 1e7) as a fraction of the FEM
- *   figure: the error shrinks b1 -> b4 (45 %, 51 %, 66 %, 79 % of FEM measured) and b4 is
- *   within [70 %, 90 %] (SEM_SANITIZED: b1, b2 only);
+ * - SEM static deflection of the paper's cantilevers b1..b4 and b10 (authors' settings:
+ *   quadratic, alpha 0.501, rays 3 x 3, 100 points per interval; default error stiffness
+ *   gamma = 1000 E / L) as a fraction of the FEM figure (issue 5): the error shrinks
+ *   b1 -> b2 -> b3 -> b4 -> b10 (35.3, 42.8, 57.0, 68.2, 93.8 % of FEM measured), b4 is within
+ *   [60 %, 76 %] and b10, the 10-section beam, within 10 % of FEM (SEM_SANITIZED: b1, b2
+ *   only). Beyond 10 sections the default does not keep converging (docs/validation.md,
+ *   section 2); that is documented, not asserted;
  * - volume convergence of the ray-cast quadrature (Fig. 7) on the exact NURBS sphere:
  *   relative error < 1e-2 at 12 x 12 rays, < 1e-3 at 48 x 48 and 10x smaller than at 12. */
 #include <stdlib.h>
@@ -47,11 +50,13 @@ static double fem_tip(void)
 
 static void test_deflection(double fem)
 {
-    int n_beams = getenv("SEM_SANITIZED") ? 2 : 4;
-    double pct[4] = {0};
-    sem_cantilever_settings s = sem_default_cantilever_settings();
-    s.gamma = 1e7; /* the authors' deflection scripts */
-    for (int k = 1; k <= n_beams; ++k) {
+    /* b1..b4 and b10 (the 10-section beam of issue 5); b8, b9 are not in the shared folder */
+    const int beams[5] = {1, 2, 3, 4, 10};
+    int n_beams = getenv("SEM_SANITIZED") ? 2 : 5;
+    double pct[5] = {0};
+    sem_cantilever_settings s = sem_default_cantilever_settings(); /* default gamma 1000 E / L */
+    for (int j = 0; j < n_beams; ++j) {
+        int k = beams[j];
         char rel[64];
         snprintf(rel, sizeof rel, "beams/perf/b%d.igs", k);
         const char *path = test_shared_model(rel);
@@ -71,17 +76,22 @@ static void test_deflection(double fem)
             sem_model_destroy(m);
             return;
         }
-        pct[k - 1] = 100.0 * r.tip_deflection / fem;
+        pct[j] = 100.0 * r.tip_deflection / fem;
         printf("b%d: %d parts, %d dofs, tip %.4f m = %.2f %% of FEM (%d Newton iterations, %.2f s)\n", k,
-               r.parts, r.dofs, r.tip_deflection, pct[k - 1], r.newton_iterations,
+               r.parts, r.dofs, r.tip_deflection, pct[j], r.newton_iterations,
                r.preprocess_s + r.solve_s);
         CHECK(m->n_parts == 6 + 4 * (k - 1), "b%d has %d parts", k, m->n_parts);
         CHECK_REL(r.volume, 5.0, 5e-3);
-        CHECK(pct[k - 1] > 35 && pct[k - 1] < 100, "b%d at %.2f %% of FEM", k, pct[k - 1]);
-        if (k > 1) CHECK(pct[k - 1] > pct[k - 2] + 3, "error not shrinking b%d -> b%d", k - 1, k);
+        CHECK(pct[j] > 30 && pct[j] < 110, "b%d at %.2f %% of FEM", k, pct[j]);
+        /* the error shrinks from below: each beam at least 3 points of FEM closer */
+        if (j > 0) CHECK(pct[j] > pct[j - 1] + 3, "error not shrinking b%d -> b%d (%.2f -> %.2f %%)",
+                         beams[j - 1], k, pct[j - 1], pct[j]);
         sem_model_destroy(m);
     }
-    if (n_beams == 4) CHECK(pct[3] > 70 && pct[3] < 90, "b4 at %.2f %% of FEM, expected 70..90", pct[3]);
+    if (n_beams == 5) {
+        CHECK(pct[3] > 60 && pct[3] < 76, "b4 at %.2f %% of FEM, expected 60..76", pct[3]);
+        CHECK(pct[4] > 90 && pct[4] < 110, "b10 at %.2f %% of FEM, not within 10 %% (issue 5)", pct[4]);
+    }
 }
 
 static double sphere_error(const sem_model *m, const sem_raycast_scene *scene, int n)

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Regenerates every data file and plot of docs/validation.md (about 15 minutes on 2 cores).
+# Regenerates every data file and plot of docs/validation.md (about 20 minutes on 2 cores).
 # usage (from the repository root): validation/regenerate.sh [BUILD_DIR]   (default build,
 # a Release build; the shared models are found as for the tests, or set SEM_SHARED_MODELS)
 # The FEM reference validation/fem_cantilever.json is not regenerated here: run
@@ -10,6 +10,7 @@ V=validation
 FEM="--fem $V/fem_cantilever.json"
 "$B"/study_deflection $FEM --gamma 1e7 > $V/deflection_g1e7.dat
 "$B"/study_deflection $FEM --gamma 1e9 --no-files > $V/deflection_g1e9.dat
+"$B"/study_deflection $FEM --gamma 1e10 --no-files > $V/deflection_g1e10.dat
 "$B"/study_deflection $FEM > $V/deflection_default.dat
 "$B"/study_deflection $FEM --no-generated --material stable_neohookean > $V/deflection_default_snh.dat
 "$B"/study_deflection $FEM --no-generated --gamma 1e7 --material stable_neohookean > $V/deflection_snh.dat
