@@ -9,8 +9,10 @@
  * Each model runs with the authors' settings from their released example scripts (models
  * README): order, ray grid, points per interval, alpha; the defaults where a script gives
  * none. Columns: our time per phase / the paper's, and the speed-up paper / ours. Our quad
- * column includes building the Embree scene (tessellation + orientation fix), see
- * src/preprocess/preprocess.c. The best of --repeat runs (default 3) is reported.
+ * column is the ray-cast quadrature alone: building the Embree scene that quadrature and
+ * weights share (tessellation, orientation fix, winding-number tree) is timed apart as
+ * scene_s (see src/preprocess/preprocess.c and `sem bench`). The best of --repeat runs
+ * (default 3) is reported.
  */
 #include <omp.h>
 #include <stdio.h>

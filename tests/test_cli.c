@@ -245,6 +245,45 @@ static void test_shared_models(void)
     }
 }
 
+/* `sem bench` on one Table 1 row: the JSON keys issue #5 names, the paper's Nnz% of the
+ * twisting beam (46.94 %, Table 1), positive timings with the factorization inside the
+ * step, and bad options rejected. */
+static void test_bench(void)
+{
+    const char *beam = test_shared_model("beams/beam_cmp3_b.iges");
+    if (!beam) {
+        printf("skip bench: shared models absent\n");
+        return;
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", beam);
+    char *cut = strstr(dir, "beams/beam_cmp3_b.iges");
+    if (!cut) return;
+    *cut = '\0';
+    int rc = run("bench --models '%s' --only 'Beam (twist)' --json --steps 2 --repeat 2", dir);
+    CHECK(rc == 0, "bench exit %d: %s", rc, err);
+    cJSON *list = cJSON_Parse(out);
+    CHECK(cJSON_IsArray(list) && cJSON_GetArraySize(list) == 1, "bench --json: one row expected: %s", out);
+    const cJSON *row = cJSON_GetArrayItem(list, 0);
+    if (row) {
+        CHECK(json_number(row, "dofs") == 756, "dofs %g", json_number(row, "dofs"));
+        CHECK_NEAR(json_number(row, "nnz_percent"), 46.94, 0.005);
+        const char *keys[] = {"sample_s", "scene_s", "quad_s", "weights_s", "build_pi_s", "step_s", "factor_s"};
+        for (size_t k = 0; k < sizeof keys / sizeof keys[0]; ++k) {
+            double v = json_number(row, keys[k]);
+            CHECK(v > 0 && v < 60, "%s = %g", keys[k], v);
+        }
+        CHECK(json_number(row, "factor_s") <= json_number(row, "step_s"), "factor %g > step %g",
+              json_number(row, "factor_s"), json_number(row, "step_s"));
+        const cJSON *paper = cJSON_GetObjectItemCaseSensitive(row, "paper");
+        CHECK(paper && json_number(paper, "step_s") == 3.95, "paper figures missing");
+    }
+    cJSON_Delete(list);
+    rc = run("bench --models '%s' --repeat 0", dir);
+    CHECK(rc != 0, "--repeat 0 accepted");
+    check_one_error_line("bench --repeat 0");
+}
+
 int main(void)
 {
     const char *dir = test_tmpdir();
@@ -254,5 +293,6 @@ int main(void)
     test_convert(dir);
     test_errors(dir);
     test_shared_models();
+    test_bench();
     return test_finish("test_cli");
 }
