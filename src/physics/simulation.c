@@ -1249,6 +1249,8 @@ static void blocks_multiply(const object *o, double cM, double cE, double cK, do
 static void fill_system(object *o, double cM, double cE, double cK, double cD)
 {
     double *val = sem_linear_solver_values(o->solver);
+    /* every block entry has its own position (or none): the group pairs are independent */
+#pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
     for (int g = 0; g < o->n_gpairs; ++g) {
         size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
         size_t off = o->gpair_offset[g], n = na * nb;
