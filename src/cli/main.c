@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <unistd.h>
+
 #include "cli.h"
 
 #ifndef SEM_VERSION_STRING
@@ -196,8 +198,28 @@ static void print_command_help(const cli_command *c)
     printf("usage: sem %s %s\n\n%s\n\n%s", c->name, c->usage, c->summary, c->help);
 }
 
+/* OpenMP threads that spin-wait after a parallel region take the second core from
+ * OpenBLAS's threads in the factorization that follows, and OpenBLAS's spinning threads
+ * take it back from the next parallel region: on 2 cores that made a 650-dof step (4 ms
+ * of factorization) take 14-20 ms instead of 7-11 (sem bench, rockets). The OpenMP
+ * runtime reads its wait policy once, from the environment, before main runs; so unless
+ * the user chose one, sem restarts itself once with OMP_WAIT_POLICY=passive (sleeping
+ * threads). Programs using libsem directly can set the variable themselves. */
+static void prefer_passive_openmp(char **argv)
+{
+#if defined(__linux__)
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT")) return;
+    if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+    execv("/proc/self/exe", argv);
+    unsetenv("OMP_WAIT_POLICY"); /* exec failed: carry on as we are */
+#else
+    (void)argv;
+#endif
+}
+
 int main(int argc, char **argv)
 {
+    prefer_passive_openmp(argv);
     if (argc < 2) {
         print_help(stderr);
         return CLI_USAGE;
