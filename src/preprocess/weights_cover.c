@@ -43,7 +43,10 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     double *scale = malloc((size_t)nq * sizeof(double));
     double *dist = malloc((size_t)nq * sizeof(double));
     int *best = malloc(COVER_POINTS * sizeof(int));
-    if (!rows || !cols || !vals || !scale || !dist || !best) {
+    /* samples grouped by part (counting sort), so a missing part scans only its own */
+    int *part_start = calloc((size_t)np + 2, sizeof(int));
+    int *part_samples = malloc(((size_t)d->n_samples + 1) * sizeof(int));
+    if (!rows || !cols || !vals || !scale || !dist || !best || !part_start || !part_samples) {
         free(rows);
         free(cols);
         free(vals);
@@ -51,8 +54,14 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
         free(dist);
         free(best);
         free(seen);
+        free(part_start);
+        free(part_samples);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
+    for (int s = 0; s < d->n_samples; ++s) part_start[d->sample_part[s] + 2]++;
+    for (int i = 0; i < np; ++i) part_start[i + 2] += part_start[i + 1];
+    for (int s = 0; s < d->n_samples; ++s) part_samples[part_start[d->sample_part[s] + 1]++] = s;
+    /* now part_start[i] .. part_start[i + 1] are part i's samples */
     for (int p = 0; p < nq; ++p) scale[p] = 1.0;
     size_t n = 0;
     /* new entries first (their rows' other weights are scaled below) */
@@ -61,9 +70,8 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
         for (int p = 0; p < nq; ++p) {
             double dm = INFINITY;
             const double *X = d->quad_X + 3 * (size_t)p;
-            for (int s = 0; s < d->n_samples; ++s) {
-                if (d->sample_part[s] != i) continue;
-                const double *S = d->sample_X + 3 * (size_t)s;
+            for (int k = part_start[i]; k < part_start[i + 1]; ++k) {
+                const double *S = d->sample_X + 3 * (size_t)part_samples[k];
                 double dd = (X[0] - S[0]) * (X[0] - S[0]) + (X[1] - S[1]) * (X[1] - S[1]) + (X[2] - S[2]) * (X[2] - S[2]);
                 if (dd < dm) dm = dd;
             }
@@ -114,5 +122,7 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     free(dist);
     free(best);
     free(seen);
+    free(part_start);
+    free(part_samples);
     return st;
 }
