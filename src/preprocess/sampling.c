@@ -137,8 +137,9 @@ static void sample_part(const sem_part *part, int index, part_samples *out)
     double *bu = malloc((size_t)max_bu * sizeof *bu);
     double *bv = malloc((size_t)max_bv * sizeof *bv);
     int *index_buf = malloc((size_t)basis_max * sizeof *index_buf);
-    double *phi = malloc((size_t)basis_max * sizeof *phi);
+    double *phi = malloc(3 * (size_t)basis_max * sizeof *phi);
     if (!bu || !bv || !index_buf || !phi) goto nomem;
+    double *phi_u = phi + basis_max, *phi_v = phi + 2 * basis_max;
     int n_bu = sem_knot_breaks(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1, bu, max_bu);
     int n_bv = sem_knot_breaks(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1, bv, max_bv);
     if (trim) {
@@ -176,28 +177,35 @@ static void sample_part(const sem_part *part, int index, part_samples *out)
                         double vt = v + SEM_TRIM_NUDGE * (v_mid - v);
                         if (!sem_trim_region_inside(trim, ut, vt)) continue;
                     }
-                    double normal[3];
-                    double jac = sem_surface_normal(s, u, v, normal);
-                    double area = wu[k] * wv[l] * u_half * v_half * jac;
-                    if (!isfinite(area)) {
-                        out->status = sem_error_set(
-                            &out->err, SEM_ERR_NUMERIC,
-                            "part %d: non-finite area element at (u,v) = (%g, %g)", index, u, v);
-                        goto done;
-                    }
-                    int nb = sem_surface_basis(s, u, v, index_buf, phi, NULL, NULL);
+                    /* one rational basis row gives the point, its J row and the area
+                     * element |S_u x S_v| */
+                    int nb = sem_surface_basis(s, u, v, index_buf, phi, phi_u, phi_v);
                     int n = out->n;
-                    double X[3] = {0.0, 0.0, 0.0};
+                    double X[3] = {0.0, 0.0, 0.0}, Su[3] = {0.0, 0.0, 0.0}, Sv[3] = {0.0, 0.0, 0.0};
                     int kept = 0;
                     for (int r = 0; r < nb; ++r) {
-                        if (phi[r] == 0.0) continue;
                         const double *P = s->ctrl + 3 * (size_t)index_buf[r];
+                        for (int c = 0; c < 3; ++c) {
+                            Su[c] += phi_u[r] * P[c];
+                            Sv[c] += phi_v[r] * P[c];
+                        }
+                        if (phi[r] == 0.0) continue;
                         X[0] += phi[r] * P[0];
                         X[1] += phi[r] * P[1];
                         X[2] += phi[r] * P[2];
                         out->col[out->nnz + (size_t)kept] = index_buf[r];
                         out->val[out->nnz + (size_t)kept] = phi[r];
                         ++kept;
+                    }
+                    double nrm[3] = {Su[1] * Sv[2] - Su[2] * Sv[1], Su[2] * Sv[0] - Su[0] * Sv[2],
+                                     Su[0] * Sv[1] - Su[1] * Sv[0]};
+                    double jac = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+                    double area = wu[k] * wv[l] * u_half * v_half * jac;
+                    if (!isfinite(area)) {
+                        out->status = sem_error_set(
+                            &out->err, SEM_ERR_NUMERIC,
+                            "part %d: non-finite area element at (u,v) = (%g, %g)", index, u, v);
+                        goto done;
                     }
                     out->nnz += (size_t)kept;
                     out->row_nnz[n] = kept;
