@@ -20,7 +20,10 @@ sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
                                     sem_solver_choice choice, sem_linear_solver **out,
                                     sem_error *err);
 void sem_linear_solver_destroy(sem_linear_solver *s);
-/* The values of the pattern, to fill before each factorization. */
+/* The solver stores the matrix in its own (fill-reducing) order: translates positions in
+ * the pattern given to create (-1 stays -1) into positions of sem_linear_solver_values. */
+void sem_linear_solver_remap(const sem_linear_solver *s, int *positions, size_t count);
+/* The values, at the remapped positions, to fill before each factorization. */
 double *sem_linear_solver_values(sem_linear_solver *s);
 sem_status sem_linear_solver_factorize(sem_linear_solver *s, sem_error *err);
 /* x = A^-1 b (x may alias b). */

@@ -738,6 +738,7 @@ static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *er
             for (size_t k = 0; k < 9 * total; ++k)
                 if (o->map[k] >= 0) o->map[k] = inv[o->map[k]];
             sem_status st = sem_linear_solver_create(nf, count, sorted, wd->solver, &o->solver, err);
+            if (st == SEM_OK) sem_linear_solver_remap(o->solver, o->map, 9 * total);
             free(sorted);
             free(perm);
             free(inv);
