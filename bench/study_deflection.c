@@ -39,11 +39,8 @@ static int exists(const char *p)
 static const char *models_dir(const char *arg)
 {
     if (arg) return arg;
-    const char *env = getenv("SEM_SHARED_MODELS");
-    if (env && exists(env)) return env;
-    if (exists("../shared/models")) return "../shared/models";
-    if (exists("../../shared/models")) return "../../shared/models";
-    return "../shared/models";
+    const char *dir = sem_bench_models_dir();
+    return dir ? dir : "../shared/models";
 }
 
 static void report(const char *source, int sections, const sem_cantilever_result *r, double fem)

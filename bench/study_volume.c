@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "bench/validation.h"
 #include "preprocess/raycast.h"
 #include "preprocess/steps.h"
 #include "sem/nurbs.h"
@@ -32,11 +33,8 @@ static int exists(const char *p)
 static const char *models_dir(const char *arg)
 {
     if (arg) return arg;
-    const char *env = getenv("SEM_SHARED_MODELS");
-    if (env && exists(env)) return env;
-    if (exists("../shared/models")) return "../shared/models";
-    if (exists("../../shared/models")) return "../../shared/models";
-    return "../shared/models";
+    const char *dir = sem_bench_models_dir();
+    return dir ? dir : "../shared/models";
 }
 
 static double divergence_volume(const sem_model *m, const sem_raycast_scene *scene)

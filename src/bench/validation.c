@@ -9,8 +9,24 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 
 #include "sem/simulation.h"
+
+static int is_dir(const char *p)
+{
+    struct stat st;
+    return p && stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+const char *sem_bench_models_dir(void)
+{
+    const char *env = getenv("SEM_SHARED_MODELS");
+    if (is_dir(env)) return env;
+    if (is_dir("../shared/models")) return "../shared/models";
+    if (is_dir("../../shared/models")) return "../../shared/models";
+    return NULL;
+}
 
 sem_cantilever_settings sem_default_cantilever_settings(void)
 {

@@ -52,6 +52,10 @@ sem_status sem_fem_reference_read(const char *path, double *tip_deflection, sem_
  * *c (may be NULL). NaN with fewer than 2 usable points. */
 double sem_loglog_fit(const double *x, const double *y, int n, double *c);
 
+/* The shared models folder: $SEM_SHARED_MODELS, else ../shared/models, else
+ * ../../shared/models (the first that is a folder); NULL when none is. */
+const char *sem_bench_models_dir(void);
+
 /* Table 1 of the paper with the authors' settings (models README) and the paper's figures. */
 typedef struct sem_table1_row {
     const char *example, *file;

@@ -45,15 +45,6 @@ static int is_dir(const char *p)
     return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-static const char *default_models_dir(void)
-{
-    const char *env = getenv("SEM_SHARED_MODELS");
-    if (env && is_dir(env)) return env;
-    if (is_dir("../shared/models")) return "../shared/models";
-    if (is_dir("../../shared/models")) return "../../shared/models";
-    return NULL;
-}
-
 static sem_status run_row(const sem_table1_row *r, const char *path, int steps, int repeat,
                           bench_result *out, sem_error *err)
 {
@@ -152,7 +143,7 @@ int cmd_bench(int argc, char **argv)
         } else if (argv[i][0] == '-') return cli_usage(CMD, "unknown option '%s'", argv[i]);
         else return cli_usage(CMD, "unexpected argument '%s'", argv[i]);
     }
-    if (!dir) dir = default_models_dir();
+    if (!dir) dir = sem_bench_models_dir();
     if (!dir) return cli_fail("no models folder: pass --models DIR or set SEM_SHARED_MODELS");
     if (!is_dir(dir)) return cli_fail("%s: not a folder", dir);
 
