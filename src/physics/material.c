@@ -452,11 +452,12 @@ void sem_symmetric_eigen(int n, double *A, double *V, double *w)
 }
 
 /* 1 when the (symmetric) matrix has a Cholesky factor with positive pivots. */
-static int is_positive_definite_9x9(const double H[81])
+/* Is H + shift I positive definite (Cholesky succeeds)? */
+static int is_positive_definite_9x9(const double H[81], double shift)
 {
     double L[81];
     for (int j = 0; j < 9; ++j) {
-        double diag = H[10 * j];
+        double diag = H[10 * j] + shift;
         for (int k = 0; k < j; ++k) diag -= L[9 * j + k] * L[9 * j + k];
         if (!(diag > 0.0) || !isfinite(diag)) return 0;
         double ljj = sqrt(diag);
@@ -475,7 +476,14 @@ void sem_project_psd_9x9(double H[81])
     for (int i = 0; i < 9; ++i)
         for (int j = i + 1; j < 9; ++j)
             H[9 * i + j] = H[9 * j + i] = 0.5 * (H[9 * i + j] + H[9 * j + i]);
-    if (is_positive_definite_9x9(H)) return;
+    /* Fast path: no eigenvalue below -1e-10 of the largest diagonal entry. The clamp would
+     * move such an eigenvalue by less than that, and many Hessians sit exactly there: at
+     * rest and under rigid rotation a neo-Hookean Hessian is singular (zero modes of the
+     * infinitesimal rotations), so plain Cholesky fails on round-off and half the step's
+     * per-point work went to 9 x 9 eigendecompositions that changed nothing. */
+    double dmax = 0.0;
+    for (int i = 0; i < 9; ++i) dmax = fmax(dmax, fabs(H[10 * i]));
+    if (is_positive_definite_9x9(H, 1e-10 * dmax)) return;
     double A[81], V[81], w[9];
     memcpy(A, H, sizeof A);
     sem_symmetric_eigen(9, A, V, w);
