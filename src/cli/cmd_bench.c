@@ -6,7 +6,7 @@
  * Each row uses the paper's material and order and the authors' ray settings (models
  * README; table in src/bench/validation.c). Columns: dofs; the preprocessing phases of
  * sem_preprocess (sample, quad, weights, build Pi), each the fastest of `--repeat` runs
- * (default 3: phases of a few milliseconds vary by 2-10x on a busy 2-core machine, and the
+ * (default 5: phases of a few milliseconds vary by 2-10x on a busy 2-core machine, and the
  * fastest run is the one least disturbed), with the Embree scene build that quadrature and
  * weights share reported beside them as scene_s (the paper's table has no such column);
  * step = mean wall time of `--steps`
@@ -120,7 +120,7 @@ static void print_cell(double ours, double paper)
 
 int cmd_bench(int argc, char **argv)
 {
-    int json = 0, steps = 20, repeat = 3;
+    int json = 0, steps = 20, repeat = 5;
     const char *dir = NULL, *only = NULL;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0) json = 1;
@@ -158,16 +158,23 @@ int cmd_bench(int argc, char **argv)
                "paper", "scene");
     }
     /* Warm-up: the first preprocessing of a process pays one-off costs (Embree device,
-     * thread pools, page faults) that belong to no row; a small generated box takes them. */
+     * thread pools, page faults) that belong to no row, and the first row used to run
+     * slower than its repeats later in the process; a generated box preprocessed for about
+     * a tenth of a second takes them. */
     {
         sem_error werr;
         sem_model *box = sem_model_create();
         sem_box_def bd = sem_default_box_def();
         sem_preprocess_options wo = sem_default_preprocess_options();
-        wo.rays[0] = wo.rays[1] = 4;
-        sem_discretization *wd = NULL;
-        if (box && sem_primitive_box(box, &bd, &werr) == SEM_OK && sem_preprocess(box, &wo, &wd, &werr) == SEM_OK)
-            sem_discretization_destroy(wd);
+        wo.rays[0] = wo.rays[1] = 8;
+        if (box && sem_primitive_box(box, &bd, &werr) == SEM_OK) {
+            double t0 = omp_get_wtime();
+            for (int k = 0; k < 50 && omp_get_wtime() - t0 < 0.1; ++k) {
+                sem_discretization *wd = NULL;
+                if (sem_preprocess(box, &wo, &wd, &werr) != SEM_OK) break;
+                sem_discretization_destroy(wd);
+            }
+        }
         sem_model_destroy(box);
     }
     int ran = 0, failed = 0;

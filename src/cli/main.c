@@ -58,7 +58,7 @@ static const cli_command commands[] = {
      "  --quiet     no progress output\n"
      "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
      "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
-    {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (3)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
+    {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (5)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
 };
 
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
