@@ -17,5 +17,5 @@ FEM="--fem $V/fem_cantilever.json"
 "$B"/study_deflection $FEM --no-generated --gamma 1e7 --material linear > $V/deflection_linear.dat
 "$B"/study_scaling > $V/scaling.dat
 "$B"/study_volume > $V/volume.dat
-"$B"/sem bench --json --steps 5 > $V/bench.json
+"$B"/sem bench --json > $V/bench.json
 for p in deflection scaling volume; do gnuplot $V/$p.gp; done
