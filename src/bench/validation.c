@@ -195,33 +195,34 @@ double sem_loglog_fit(const double *x, const double *y, int n, double *c)
 }
 
 /* Paper's Table 1 (models README); settings from the authors' example scripts. The tire
- * has two materials in the paper (steel hub, rubber tread); here the tread's rubber is used
- * for the whole tire. */
+ * has the paper's two materials: tread rubber, and steel for its hub, parts 0-6 of
+ * tire.iges (the rim and axle surfaces, all within radius 0.89 of the axis; the tread and
+ * sidewall parts 7-46 reach radius 1.6). */
 const sem_table1_row sem_table1[] = {
     {"Rocket (soft)", "rocket/rocket.iges", 1.27e3, 7e6, 0.40, 2, {9, 15}, 5, 10, 648,
-     2.83e-2, 5.62e-3, 5.58e-1, 6.83e-2, 1.26, 100},
+     2.83e-2, 5.62e-3, 5.58e-1, 6.83e-2, 1.26, 100, 0, 0, 0, 0},
     {"Rocket (stiff)", "rocket/rocket.iges", 8e3, 2e11, 0.32, 1, {5, 15}, 5, 10, 648,
-     2.56e-2, 5.97e-3, 4.59e-1, 3.48e-2, 9.99e-2, 100},
+     2.56e-2, 5.97e-3, 4.59e-1, 3.48e-2, 9.99e-2, 100, 0, 0, 0, 0},
     {"Starship", "starship/starship_fall_simpler.igs", 8e3, 2e11, 0.32, 1, {10, 10}, 5, 0.7, 750,
-     6.78e-2, 1.52e-2, 8.50e-1, 9.52e-2, 6.95e-1, 100},
+     6.78e-2, 1.52e-2, 8.50e-1, 9.52e-2, 6.95e-1, 100, 0, 0, 0, 0},
     {"Beam (twist)", "beams/beam_cmp3_b.iges", 1e3, 1e6, 0.45, 2, {3, 3}, 15, 0.51, 756,
-     1.97e-1, 2.25e-2, 1.35, 5.16e-1, 3.95, 46.94},
+     1.97e-1, 2.25e-2, 1.35, 5.16e-1, 3.95, 46.94, 0, 0, 0, 0},
     {"Lamppost", "lamppost.iges", 3e3, 1e6, 0.40, 2, {5, 35}, 2, 0.8, 942,
-     1.28e-1, 1.27e-2, 1.89, 1.07, 2.22, 56.38},
+     1.28e-1, 1.27e-2, 1.89, 1.07, 2.22, 56.38, 0, 0, 0, 0},
     {"Tire", "tire.iges", 2e3, 1e6, 0.47, 2, {9, 9}, 4, 1.1, 1404,
-     1.74e-1, 1.32e-2, 1.82, 6.79e-1, 12.8, 92.5},
+     1.74e-1, 1.32e-2, 1.82, 6.79e-1, 12.8, 92.5, 7, 3e3, 7e9, 0.35},
     {"Chicken", "chicken/chicken_simple_closed.iges", 1.27e3, 1e4, 0.47, 2, {6, 6}, 3, 0, 1773,
-     9.19e-1, 2.31e-2, 3.38, 1.91, 10.8, 100},
+     9.19e-1, 2.31e-2, 3.38, 1.91, 10.8, 100, 0, 0, 0, 0},
     {"Coffee mug (soft)", "mugs/mug_trimmed_complex.iges", 1e3, 1e4, 0.47, 2, {10, 10}, 5, 0, 1800,
-     4.18e-1, 2.87e-2, 3.77, 2.08, 11.9, 100},
+     4.18e-1, 2.87e-2, 3.77, 2.08, 11.9, 100, 0, 0, 0, 0},
     {"Coffee mug (stiff)", "mugs/mug_trimmed_complex.iges", 1e3, 4e7, 0.40, 2, {10, 10}, 5, 0, 1800,
-     4.15e-2, 1.17e-2, 6.86e-1, 1.09e-1, 5.00e-1, 81.42},
+     4.15e-2, 1.17e-2, 6.86e-1, 1.09e-1, 5.00e-1, 81.42, 0, 0, 0, 0},
     {"Castle", "castle/castle_super_simple.iges", 1.27e3, 2e3, 0.45, 2, {12, 15}, 12, 0, 1872,
-     4.84e-1, 1.44e-2, 1.52, 5.78e-1, 8.02, 100},
+     4.84e-1, 1.44e-2, 1.52, 5.78e-1, 8.02, 100, 0, 0, 0, 0},
     {"Grumpy", "grumpy.iges", 1e3, 1e4, 0.40, 2, {10, 10}, 5, 0, 2010,
-     2.92e-1, 1.23e-2, 2.29, 2.89, 6.02, 84.15},
+     2.92e-1, 1.23e-2, 2.29, 2.89, 6.02, 84.15, 0, 0, 0, 0},
     {"Astronaut (soft)", "puft/puft_full_simpler.iges", 1.27e3, 1e6, 0.47, 2, {8, 15}, 3, 0, 3609,
-     2.47, 6.71e-2, 11.3, 10.9, 14.1, 49.04},
+     2.47, 6.71e-2, 11.3, 10.9, 14.1, 49.04, 0, 0, 0, 0},
 };
 
 const int sem_table1_count = (int)(sizeof sem_table1 / sizeof sem_table1[0]);

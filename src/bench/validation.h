@@ -64,6 +64,10 @@ typedef struct sem_table1_row {
     double alpha;            /* 0: the default rule */
     int paper_q;
     double paper_sample, paper_quad, paper_weights, paper_build_pi, paper_step, paper_nnz;
+    /* A second material for parts 0 .. inner_parts - 1 (the tire's steel hub; a quadrature
+     * point takes the material of the innermost part it lies in); 0: one material. */
+    int inner_parts;
+    double inner_density, inner_youngs_modulus, inner_poisson_ratio;
 } sem_table1_row;
 
 extern const sem_table1_row sem_table1[];

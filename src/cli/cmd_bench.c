@@ -90,7 +90,25 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     od.material.density = r->density;
     od.material.youngs_modulus = r->youngs_modulus;
     od.material.poisson_ratio = r->poisson_ratio;
-    if (sem_world_add_object(w, &od, err) < 0) {
+    sem_material inner = od.material;
+    int *part_material = NULL;
+    if (r->inner_parts > 0) {
+        part_material = malloc((size_t)m->n_parts * sizeof *part_material);
+        if (!part_material) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        for (int p = 0; p < m->n_parts; ++p) part_material[p] = p < r->inner_parts ? 0 : -1;
+        inner.density = r->inner_density;
+        inner.youngs_modulus = r->inner_youngs_modulus;
+        inner.poisson_ratio = r->inner_poisson_ratio;
+        od.part_material = part_material;
+        od.part_materials = &inner;
+        od.n_part_materials = 1;
+    }
+    int added = sem_world_add_object(w, &od, err);
+    free(part_material);
+    if (added < 0) {
         st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
         goto done;
     }

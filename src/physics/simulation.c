@@ -48,7 +48,8 @@ typedef struct object {
     int n_ctrl, n_parts, m, n_quad;
     double *q, *v, *q0;        /* 3 n_ctrl */
     /* per quadrature point */
-    const sem_material **point_material;
+    const sem_material **point_material; /* into material / part_mats of this object */
+    sem_material *part_mats;   /* initialized copies of def->part_materials */
     double *point_rho_vol;
     double *entry_grad;        /* per W entry: m x 3, w * d b_k / dX_e */
     double *entry_basis;       /* per W entry: m, w * b_k */
@@ -171,6 +172,7 @@ static void object_destroy(object *o)
     free(o->entry_grad);
     free(o->entry_basis);
     free(o->entry_pair_offset);
+    free(o->part_mats);
     free(o->point_cost);
     free(o->pair_upper);
     free(o->point_pairs);
@@ -752,13 +754,13 @@ static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *er
     return SEM_OK;
 }
 
-static const sem_material *material_of_part(const sem_object_def *def, int part)
+static const sem_material *material_of_part(const object *o, const sem_object_def *def, int part)
 {
-    if (def->part_material && def->part_materials) {
+    if (def->part_material && o->part_mats) {
         int k = def->part_material[part];
-        if (k >= 0 && k < def->n_part_materials) return &def->part_materials[k];
+        if (k >= 0 && k < def->n_part_materials) return &o->part_mats[k];
     }
-    return &def->material;
+    return &o->def.material;
 }
 
 static void compute_gravity(object *o, const double g[3])
@@ -843,9 +845,18 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         sem_material mat = def->material;
         if ((st = sem_material_init(&mat, err)) != SEM_OK) goto fail;
         o->def.material = mat;
-        for (int k = 0; k < def->n_part_materials; ++k) {
-            sem_material pm = def->part_materials[k];
-            if ((st = sem_material_init(&pm, err)) != SEM_OK) goto fail;
+        /* the object keeps initialized copies: the caller's array need not outlive this
+         * call, and its Lame parameters need not be set */
+        if (def->part_materials && def->n_part_materials > 0) {
+            o->part_mats = malloc((size_t)def->n_part_materials * sizeof *o->part_mats);
+            if (!o->part_mats) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+            for (int k = 0; k < def->n_part_materials; ++k) {
+                o->part_mats[k] = def->part_materials[k];
+                if ((st = sem_material_init(&o->part_mats[k], err)) != SEM_OK) goto fail;
+            }
         }
     }
     sem_model_get_q(def->model, o->q0);
@@ -855,12 +866,14 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     for (int p = 0; p < o->n_quad; ++p) {
         int part = d->quad_part ? d->quad_part[p] : 0;
         if (part < 0 || part >= o->n_parts) part = 0;
-        const sem_material *mt = material_of_part(&o->def, part);
+        const sem_material *mt = material_of_part(o, def, part);
         o->point_material[p] = mt;
         o->point_rho_vol[p] = mt->density * d->quad_volume[p];
         o->volume += d->quad_volume[p];
         o->mass += o->point_rho_vol[p];
     }
+    o->def.part_material = NULL; /* the caller's arrays: read above, not kept */
+    o->def.part_materials = NULL;
     if (def->pinned) memcpy(o->pinned, def->pinned, (size_t)o->n_ctrl);
     o->presc_index = malloc((size_t)o->n_ctrl * sizeof(int));
     o->n_presc = def->prescribe_group ? def->n_prescribes : 1;
