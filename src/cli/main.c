@@ -204,11 +204,15 @@ static void print_command_help(const cli_command *c)
  * of factorization) take 14-20 ms instead of 7-11 (sem bench, rockets). The OpenMP
  * runtime reads its wait policy once, from the environment, before main runs; so unless
  * the user chose one, sem restarts itself once with OMP_WAIT_POLICY=passive (sleeping
- * threads). Programs using libsem directly can set the variable themselves. */
+ * threads); SEM_NO_RESTART=1 turns that off, and it is skipped under valgrind. Programs
+ * using libsem directly can set the variable themselves. */
 static void prefer_passive_openmp(char **argv)
 {
 #if defined(__linux__)
-    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT")) return;
+    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT") || getenv("SEM_NO_RESTART")) return;
+    /* under valgrind the restarted process would run outside it */
+    const char *preload = getenv("LD_PRELOAD");
+    if (preload && strstr(preload, "vgpreload")) return;
     if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
     execv("/proc/self/exe", argv);
     unsetenv("OMP_WAIT_POLICY"); /* exec failed: carry on as we are */
