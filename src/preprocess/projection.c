@@ -515,24 +515,17 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
     cx.d = d;
     cx.order = order;
     cx.m = m;
-    cx.sample_start = calloc((size_t)n_parts + 1, sizeof *cx.sample_start);
-    cx.sample_index = malloc(((size_t)d->n_samples + 1) * sizeof *cx.sample_index);
+    /* samples of each part (sampling already emits them in order) */
+    sem_samples_by_part(d, &cx.sample_start, &cx.sample_index);
     cx.group_col0 = malloc((size_t)n_parts * sizeof *cx.group_col0);
     cx.sums = calloc((size_t)n_parts, sizeof *cx.sums);
     cx.groups = calloc((size_t)n_origins, sizeof *cx.groups);
-    int *fill = malloc(((size_t)n_parts + 1) * sizeof *fill);
     int *group_cols = NULL;
     int *group_cols_start = NULL;
     sem_csr Pi;
     memset(&Pi, 0, sizeof Pi);
-    if (!cx.sample_start || !cx.sample_index || !cx.group_col0 || !cx.sums || !cx.groups || !fill)
+    if (!cx.sample_start || !cx.sample_index || !cx.group_col0 || !cx.sums || !cx.groups)
         goto nomem;
-
-    /* samples of each part (stable counting sort; sampling already emits them in order) */
-    for (int s = 0; s < d->n_samples; ++s) cx.sample_start[d->sample_part[s] + 1]++;
-    for (int i = 0; i < n_parts; ++i) cx.sample_start[i + 1] += cx.sample_start[i];
-    memcpy(fill, cx.sample_start, ((size_t)n_parts + 1) * sizeof *fill);
-    for (int s = 0; s < d->n_samples; ++s) cx.sample_index[fill[d->sample_part[s]]++] = s;
 
     /* groups: parts per origin (ascending) and their columns */
     for (int i = 0; i < n_parts; ++i) cx.groups[d->part_origin[i]].n_parts++;
@@ -647,7 +640,6 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
     d->Pi = Pi;
     d->order = order;
     d->n_basis = m;
-    free(fill);
     free(group_cols);
     free(group_cols_start);
     context_free(&cx, n_parts, n_origins);
@@ -657,7 +649,6 @@ nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "projection: out of memory");
 fail:
     sem_csr_free(&Pi);
-    free(fill);
     free(group_cols);
     free(group_cols_start);
     context_free(&cx, n_parts, n_origins);

@@ -353,3 +353,23 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
     d->J_hat = J;
     return SEM_OK;
 }
+
+int sem_samples_by_part(const sem_discretization *d, int **start, int **index)
+{
+    int np = d->n_parts;
+    *start = calloc((size_t)np + 2, sizeof **start);
+    *index = malloc(((size_t)d->n_samples + 1) * sizeof **index);
+    if (!*start || !*index) {
+        free(*start);
+        free(*index);
+        *start = *index = NULL;
+        return 0;
+    }
+    int *st = *start;
+    /* counts at i + 2, prefix sums shifted by one, then filling through st[i + 1] leaves
+     * st[i] at part i's first sample */
+    for (int s = 0; s < d->n_samples; ++s) st[d->sample_part[s] + 2]++;
+    for (int i = 0; i < np; ++i) st[i + 2] += st[i + 1];
+    for (int s = 0; s < d->n_samples; ++s) (*index)[st[d->sample_part[s] + 1]++] = s;
+    return 1;
+}

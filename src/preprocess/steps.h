@@ -18,6 +18,10 @@
  * their spans are subdivided to at least 24 points per direction so a small trimmed region
  * is never missed. */
 sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_error *err);
+/* The samples of each part: (*start)[i] .. (*start)[i + 1] index (*index), a stable counting
+ * sort by sample_part, so each part's samples stay in sample order. Both arrays are
+ * allocated here (n_parts + 1 and n_samples entries); 0 when out of memory (none left). */
+int sem_samples_by_part(const sem_discretization *d, int **start, int **index);
 
 /* quadrature.c: fills n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11). */
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,

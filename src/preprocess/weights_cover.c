@@ -43,10 +43,10 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     double *scale = malloc((size_t)nq * sizeof(double));
     double *dist = malloc((size_t)nq * sizeof(double));
     int *best = malloc(COVER_POINTS * sizeof(int));
-    /* samples grouped by part (counting sort), so a missing part scans only its own */
-    int *part_start = calloc((size_t)np + 2, sizeof(int));
-    int *part_samples = malloc(((size_t)d->n_samples + 1) * sizeof(int));
-    if (!rows || !cols || !vals || !scale || !dist || !best || !part_start || !part_samples) {
+    /* samples grouped by part, so a missing part scans only its own */
+    int *part_start = NULL, *part_samples = NULL;
+    int grouped = sem_samples_by_part(d, &part_start, &part_samples);
+    if (!rows || !cols || !vals || !scale || !dist || !best || !grouped) {
         free(rows);
         free(cols);
         free(vals);
@@ -58,10 +58,6 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
         free(part_samples);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
-    for (int s = 0; s < d->n_samples; ++s) part_start[d->sample_part[s] + 2]++;
-    for (int i = 0; i < np; ++i) part_start[i + 2] += part_start[i + 1];
-    for (int s = 0; s < d->n_samples; ++s) part_samples[part_start[d->sample_part[s] + 1]++] = s;
-    /* now part_start[i] .. part_start[i + 1] are part i's samples */
     for (int p = 0; p < nq; ++p) scale[p] = 1.0;
     size_t n = 0;
     /* new entries first (their rows' other weights are scaled below) */
