@@ -906,6 +906,8 @@ double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const do
  * (the first-order far field from 2 radii, used before, reached 0.156 on the tire), at
  * about half the cost. */
 #define WINDING_BETA_COARSE 1.5
+/* The middle level of sem_raycast_winding_above's cascade (worst error 0.013 measured). */
+#define WINDING_BETA_MEDIUM 4.0
 #define WINDING_LEAF 8
 
 /* A leaf triangle as the winding number reads it: vertices in corrected order (v1 and v2
@@ -1072,7 +1074,7 @@ int sem_raycast_winding_above(const sem_raycast_scene *scene, const double X[3],
 {
     double w = winding_number_beta(scene, X, WINDING_BETA_COARSE);
     if (fabs(w - threshold) > 0.15) return w > threshold;
-    w = winding_number_beta(scene, X, 4.0);
+    w = winding_number_beta(scene, X, WINDING_BETA_MEDIUM);
     if (fabs(w - threshold) > 0.04) return w > threshold;
     return winding_number_beta(scene, X, WINDING_BETA) > threshold;
 }
