@@ -67,14 +67,7 @@ int main(int argc, char **argv)
             failures++;
             continue;
         }
-        sem_preprocess_options o = sem_default_preprocess_options();
-        o.order = b->order;
-        o.rays[0] = b->rays[0];
-        o.rays[1] = b->rays[1];
-        o.points_per_interval = b->points_per_interval;
-        o.alpha = b->alpha;
-        o.youngs_modulus = b->youngs_modulus;
-        o.tessellation = 8; /* the ray casts' triangulation; the sphere-accuracy default 16 is not needed here */
+        sem_preprocess_options o = sem_table1_options(b);
         sem_preprocess_timings best = {1e30, 1e30, 1e30, 1e30, 1e30, 1e30};
         int dofs = 0;
         double nnz = 0;
@@ -89,14 +82,7 @@ int main(int argc, char **argv)
             }
             dofs = 3 * d->n_ctrl;
             nnz = d->stiffness_nnz_percent;
-#define KEEP(f) best.f = d->timings.f < best.f ? d->timings.f : best.f
-            KEEP(sample_s);
-            KEEP(scene_s);
-            KEEP(quad_s);
-            KEEP(weights_s);
-            KEEP(build_pi_s);
-            KEEP(operators_s);
-#undef KEEP
+            sem_timings_keep_fastest(&best, &d->timings);
             sem_discretization_destroy(d);
         }
         sem_model_destroy(model);

@@ -226,3 +226,26 @@ const sem_table1_row sem_table1[] = {
 };
 
 const int sem_table1_count = (int)(sizeof sem_table1 / sizeof sem_table1[0]);
+
+sem_preprocess_options sem_table1_options(const sem_table1_row *r)
+{
+    sem_preprocess_options o = sem_default_preprocess_options();
+    o.order = r->order;
+    o.rays[0] = r->rays[0];
+    o.rays[1] = r->rays[1];
+    o.points_per_interval = r->points_per_interval;
+    o.alpha = r->alpha;
+    o.youngs_modulus = r->youngs_modulus;
+    o.tessellation = 8;
+    return o;
+}
+
+void sem_timings_keep_fastest(sem_preprocess_timings *best, const sem_preprocess_timings *t)
+{
+    best->sample_s = fmin(best->sample_s, t->sample_s);
+    best->scene_s = fmin(best->scene_s, t->scene_s);
+    best->quad_s = fmin(best->quad_s, t->quad_s);
+    best->weights_s = fmin(best->weights_s, t->weights_s);
+    best->build_pi_s = fmin(best->build_pi_s, t->build_pi_s);
+    best->operators_s = fmin(best->operators_s, t->operators_s);
+}

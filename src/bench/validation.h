@@ -73,4 +73,12 @@ typedef struct sem_table1_row {
 extern const sem_table1_row sem_table1[];
 extern const int sem_table1_count;
 
+/* The preprocessing options of a row: its order, rays, points per interval, alpha and E (for
+ * the default gamma), and tessellation 8 (the ray casts' triangulation; the sphere-accuracy
+ * default 16 is not an authors' setting and not needed here). */
+sem_preprocess_options sem_table1_options(const sem_table1_row *r);
+
+/* Keeps in *best the fastest of each phase seen so far (*best starts as the first run). */
+void sem_timings_keep_fastest(sem_preprocess_timings *best, const sem_preprocess_timings *t);
+
 #endif

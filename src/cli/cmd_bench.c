@@ -35,7 +35,8 @@
 
 typedef struct bench_result {
     int dofs;
-    double sample_s, scene_s, quad_s, weights_s, build_pi_s, step_s, factor_s, nnz_percent;
+    sem_preprocess_timings pre; /* the fastest run of each phase */
+    double step_s, factor_s, nnz_percent;
     const char *solver;
 } bench_result;
 
@@ -51,14 +52,7 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     sem_model *m = NULL;
     sem_status st = sem_model_load(path, &m, err);
     if (st != SEM_OK) return st;
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.order = r->order;
-    po.rays[0] = r->rays[0];
-    po.rays[1] = r->rays[1];
-    po.points_per_interval = r->points_per_interval;
-    po.tessellation = 8; /* ray-cast triangulation as in bench/bench_preprocess.c (not an authors' setting) */
-    po.alpha = r->alpha;
-    po.youngs_modulus = r->youngs_modulus;
+    sem_preprocess_options po = sem_table1_options(r);
     sem_discretization *d = NULL;
     sem_world *w = NULL;
     for (int k = 0; k < repeat; ++k) {
@@ -66,12 +60,8 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
         d = NULL;
         st = sem_preprocess(m, &po, &d, err);
         if (st != SEM_OK) goto done;
-        const sem_preprocess_timings *t = &d->timings;
-        if (k == 0 || t->sample_s < out->sample_s) out->sample_s = t->sample_s;
-        if (k == 0 || t->scene_s < out->scene_s) out->scene_s = t->scene_s;
-        if (k == 0 || t->quad_s < out->quad_s) out->quad_s = t->quad_s;
-        if (k == 0 || t->weights_s < out->weights_s) out->weights_s = t->weights_s;
-        if (k == 0 || t->build_pi_s < out->build_pi_s) out->build_pi_s = t->build_pi_s;
+        if (k == 0) out->pre = d->timings;
+        else sem_timings_keep_fastest(&out->pre, &d->timings);
     }
     out->dofs = 3 * d->n_ctrl;
 
@@ -207,7 +197,9 @@ int cmd_bench(int argc, char **argv)
             continue;
         }
         fprintf(stderr, "sem bench: [%d/%d] %s (%s)...\n", k + 1, sem_table1_count, r->example, r->file);
-        bench_result b = {0, 0, 0, 0, 0, 0, 0, 0, 0, "none"};
+        bench_result b;
+        memset(&b, 0, sizeof b);
+        b.solver = "none";
         sem_error err;
         sem_error_clear(&err);
         double t0 = omp_get_wtime();
@@ -229,11 +221,11 @@ int cmd_bench(int argc, char **argv)
             cJSON_AddStringToObject(o, "file", r->file);
             cJSON_AddNumberToObject(o, "order", r->order);
             cJSON_AddNumberToObject(o, "dofs", b.dofs);
-            cJSON_AddNumberToObject(o, "sample_s", b.sample_s);
-            cJSON_AddNumberToObject(o, "scene_s", b.scene_s);
-            cJSON_AddNumberToObject(o, "quad_s", b.quad_s);
-            cJSON_AddNumberToObject(o, "weights_s", b.weights_s);
-            cJSON_AddNumberToObject(o, "build_pi_s", b.build_pi_s);
+            cJSON_AddNumberToObject(o, "sample_s", b.pre.sample_s);
+            cJSON_AddNumberToObject(o, "scene_s", b.pre.scene_s);
+            cJSON_AddNumberToObject(o, "quad_s", b.pre.quad_s);
+            cJSON_AddNumberToObject(o, "weights_s", b.pre.weights_s);
+            cJSON_AddNumberToObject(o, "build_pi_s", b.pre.build_pi_s);
             cJSON_AddNumberToObject(o, "step_s", b.step_s);
             cJSON_AddNumberToObject(o, "factor_s", b.factor_s);
             cJSON_AddNumberToObject(o, "nnz_percent", b.nnz_percent);
@@ -250,12 +242,12 @@ int cmd_bench(int argc, char **argv)
             }
         } else {
             printf("%-19s %5d %5d |", r->example, b.dofs, r->paper_q);
-            print_cell(b.sample_s, r->paper_sample);
-            print_cell(b.quad_s, r->paper_quad);
-            print_cell(b.weights_s, r->paper_weights);
-            print_cell(b.build_pi_s, r->paper_build_pi);
+            print_cell(b.pre.sample_s, r->paper_sample);
+            print_cell(b.pre.quad_s, r->paper_quad);
+            print_cell(b.pre.weights_s, r->paper_weights);
+            print_cell(b.pre.build_pi_s, r->paper_build_pi);
             print_cell(b.step_s, r->paper_step);
-            printf(" %8.2e | %6.2f %6.2f | %8.2e\n", b.factor_s, b.nnz_percent, r->paper_nnz, b.scene_s);
+            printf(" %8.2e | %6.2f %6.2f | %8.2e\n", b.factor_s, b.nnz_percent, r->paper_nnz, b.pre.scene_s);
             fflush(stdout);
         }
     }
