@@ -308,36 +308,18 @@ static double spin_elastic_energy(int n_part_materials, double density_factor, d
     wd.dt = 0.01;
     sem_object_def od = sem_default_object_def();
     od.initial_angular_velocity[2] = 3.0;
-    setup s;
-    memset(&s, 0, sizeof s);
-    sem_error err;
-    s.model = sem_model_create();
-    sem_box_def bd = sem_default_box_def();
-    bd.size[0] = 2.0;
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.rays[0] = po.rays[1] = 4;
-    po.points_per_interval = 4;
-    double e = -1;
-    if (sem_primitive_box(s.model, &bd, &err) != SEM_OK || sem_preprocess(s.model, &po, &s.disc, &err) != SEM_OK ||
-        !(s.world = sem_world_create(&wd, &err))) {
-        CHECK(0, "setup: %s", err.message);
-        setup_free(&s);
-        return e;
-    }
-    od.model = s.model;
-    od.disc = s.disc;
+    enum { BOX_PARTS = 6 }; /* sem_primitive_box's patches */
     int *pm = NULL;
     sem_material *mats = NULL;
     if (n_part_materials > 0) {
-        pm = malloc((size_t)s.model->n_parts * sizeof *pm);
+        pm = malloc(BOX_PARTS * sizeof *pm);
         mats = calloc(1, sizeof *mats);
         if (!pm || !mats) {
             free(pm);
             free(mats);
-            setup_free(&s);
-            return e;
+            return -1;
         }
-        for (int p = 0; p < s.model->n_parts; ++p) pm[p] = 0;
+        for (int p = 0; p < BOX_PARTS; ++p) pm[p] = 0;
         mats[0].type = od.material.type;
         mats[0].density = density_factor * od.material.density;
         mats[0].youngs_modulus = od.material.youngs_modulus;
@@ -346,18 +328,21 @@ static double spin_elastic_energy(int n_part_materials, double density_factor, d
         od.part_materials = mats;
         od.n_part_materials = 1;
     }
-    int id = sem_world_add_object(s.world, &od, &err);
-    free(pm);
+    setup s;
+    int ok = make_box_world(&s, 2, &wd, &od);
+    free(pm); /* the object must not need them after it is added */
     free(mats);
-    CHECK(id == 0, "add object: %s", err.message);
-    int ok = id == 0;
+    if (ok) CHECK(s.model->n_parts == BOX_PARTS, "box has %d parts", s.model->n_parts);
+    sem_error err;
     for (int k = 0; k < 20 && ok; ++k) ok = sem_world_step(s.world, &err) == SEM_OK;
-    CHECK(ok, "step: %s", err.message);
+    double e = -1;
     if (ok) {
         sem_object_stats st;
         sem_world_object_stats(s.world, 0, &st);
         e = st.elastic_energy;
         *mass = st.mass;
+    } else {
+        CHECK(0, "spinning box failed");
     }
     setup_free(&s);
     return e;
