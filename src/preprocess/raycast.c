@@ -164,8 +164,8 @@ struct sem_raycast_scene {
     /* fast winding number tree (see sem_raycast_winding_number) */
     struct winding_node *winding_nodes;
     int n_winding_nodes;
-    int *winding_order;       /* triangle indices in tree order */
-    signed char *winding_sign; /* part_sign of each triangle */
+    int *winding_order;       /* build scratch: triangle indices in tree order */
+    signed char *winding_sign; /* build scratch: part_sign of each triangle */
     struct winding_tri *winding_tris; /* the triangles in tree order, orientation-corrected */
     int winding_failed;       /* out of memory while building it: exact sums instead */
     /* per-part bounding-volume trees for closest-point queries (built on first use) */
@@ -1051,6 +1051,11 @@ static int build_winding_tree(sem_raycast_scene *s)
         wt->r2 = r2;
     }
     free(centroid);
+    /* queries read winding_tris only */
+    free(s->winding_order);
+    free(s->winding_sign);
+    s->winding_order = NULL;
+    s->winding_sign = NULL;
     return 1;
 }
 
