@@ -7,9 +7,10 @@
  * each part couples every control point of the parts sharing its origin. So the work is
  * split the way the maths factors:
  *
- *   1. z-space (polynomial coefficients, m per part per coordinate): per point, the local
- *      3x3 deformation gradient, psi, P, d2psi/dF2 and their pull-back to the coefficients
- *      of the point's parts. These 3m x 3m blocks per *part pair* are tiny and cheap.
+ *   1. z-space (polynomial coefficients, m per part per coordinate, written in one basis
+ *      b(X - ref) shared by all parts; see setup_stiffness): per point, the local 3x3
+ *      deformation gradient, psi, P, d2psi/dF2 and its pull-back N_p to the shared basis;
+ *      then per *part pair* the 3m x 3m block sum_p w_a w_b N_p.
  *   2. q-space: K_q = Pi^T K_z Pi. Pi_i's columns are exactly the control points of the
  *      parts sharing part i's origin (its "group"), so K_q is made of dense blocks per
  *      *group pair*; each part-pair block adds Pi_i^T K_z Pi_i' into one group-pair block
@@ -51,11 +52,9 @@ typedef struct object {
     const sem_material **point_material; /* into material / part_mats of this object */
     sem_material *part_mats;   /* initialized copies of def->part_materials */
     double *point_rho_vol;
-    double *entry_grad;        /* per W entry: m x 3, w * d b_k / dX_e */
     double *entry_basis;       /* per W entry: m, w * b_k */
     int *entry_pair_offset;    /* per point: start into point_pairs (k*k pairs) */
     int *point_pairs;
-    double *point_cost;        /* n_quad + 1: prefix sums of each point's assembly work */
     /* part pairs (z-space blocks) */
     int n_pairs;
     int *pair_a, *pair_b;
@@ -65,6 +64,19 @@ typedef struct object {
     int *group_start, *group_ctrl; /* CSR: control points of each group */
     int *ctrl_group, *ctrl_local;
     double **pi_dense;         /* per part: m x |group| row-major */
+    /* stiffness in one shared basis (see assemble_elastic) */
+    int ma;                    /* basis functions with a gradient: m - 1 */
+    double ref_X[3];           /* the shared basis is b(X - ref_X) */
+    double **pi_shared;        /* per part: ma x |group|, rows 1..m-1 of T_i^T Pi_i */
+    double *point_D;           /* per point: ma x 3, d b_k(X_p - ref_X) / dX_e, k = 1..m-1 */
+    int *plist_start;          /* per part pair (upper ones): its points, in order */
+    int *plist_point;
+    double *plist_w;           /* w_a w_b at that point */
+    int *plist_cursor;         /* per pair: first entry not yet summed (chunked assembly) */
+    int n_packed;              /* 3ma (3ma + 1) / 2 */
+    int chunk;                 /* points per assembly chunk */
+    double *N_chunk;           /* chunk x n_packed: vol B^T H B per point, packed upper */
+    double *Kz_packed;         /* per pair: running sum over earlier chunks */
     /* group-pair blocks */
     int n_gpairs;
     int *gpair_a, *gpair_b;
@@ -90,15 +102,13 @@ typedef struct object {
     int *map;                  /* per block entry (9 per scalar entry): CSC position or -1 */
     sem_linear_solver *solver;
     /* z-space work */
-    double *z;                 /* n_parts*m x 3 */
-    double *grad_z;            /* n_parts*m x 3 */
-    double *Kz;                /* n_pairs x (3m)^2 */
+    double *z;                 /* n_parts*ma x 3: shared-basis coefficients */
+    double *grad_z;            /* n_parts*ma x 3 */
+    double *Kz;                /* n_pairs x (3ma)^2, upper pairs only (Kz_ab = Kz_ba) */
     unsigned char *pair_upper; /* per part pair: a <= b and the pair shares a quadrature point
                                 * (the blocks the point loop writes) */
     int nthreads;
-    double *Kz_thread, *grad_z_thread;
-    int max_row;               /* most parts with weight at one quadrature point */
-    double *hg_thread;         /* per thread: max_row x 9 x 3m */
+    double *grad_z_thread;
     double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
     double elastic_energy;
     double volume, mass;
@@ -169,11 +179,9 @@ static void object_destroy(object *o)
     free(o->q0);
     free(o->point_material);
     free(o->point_rho_vol);
-    free(o->entry_grad);
     free(o->entry_basis);
     free(o->entry_pair_offset);
     free(o->part_mats);
-    free(o->point_cost);
     free(o->pair_upper);
     free(o->point_pairs);
     free(o->pair_a);
@@ -186,6 +194,16 @@ static void object_destroy(object *o)
     if (o->pi_dense)
         for (int i = 0; i < o->n_parts; ++i) free(o->pi_dense[i]);
     free(o->pi_dense);
+    if (o->pi_shared)
+        for (int i = 0; i < o->n_parts; ++i) free(o->pi_shared[i]);
+    free(o->pi_shared);
+    free(o->point_D);
+    free(o->plist_start);
+    free(o->plist_point);
+    free(o->plist_w);
+    free(o->plist_cursor);
+    free(o->N_chunk);
+    free(o->Kz_packed);
     free(o->gpair_a);
     free(o->gpair_b);
     free(o->gpair_lookup);
@@ -207,8 +225,6 @@ static void object_destroy(object *o)
     free(o->z);
     free(o->grad_z);
     free(o->Kz);
-    free(o->Kz_thread);
-    free(o->hg_thread);
     free(o->qc);
     free(o->grad_z_thread);
     free((void *)o->def.point_loads);
@@ -407,17 +423,17 @@ static sem_status setup_pairs(object *o, sem_error *err)
     return SEM_OK;
 }
 
-/* Per-point data in z-space: w * b and w * grad b at X_p - Xbar_i for each weight entry. */
+/* Per-point data in z-space: w * b at X_p - Xbar_i for each weight entry (mass), and the
+ * point's part pairs. */
 static sem_status setup_points(object *o, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
     size_t n_entries = sem_csr_nnz(W);
     int m = o->m;
-    o->entry_grad = malloc((n_entries * (size_t)m * 3 + 1) * sizeof(double));
     o->entry_basis = malloc((n_entries * (size_t)m + 1) * sizeof(double));
     o->entry_pair_offset = malloc(((size_t)o->n_quad + 1) * sizeof(int));
-    if (!o->entry_grad || !o->entry_basis || !o->entry_pair_offset)
+    if (!o->entry_basis || !o->entry_pair_offset)
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     size_t n_pp = 0;
     o->entry_pair_offset[0] = 0;
@@ -427,16 +443,8 @@ static sem_status setup_points(object *o, sem_error *err)
         o->entry_pair_offset[p + 1] = (int)n_pp;
     }
     o->point_pairs = malloc((n_pp + 1) * sizeof(int));
-    o->point_cost = malloc(((size_t)o->n_quad + 1) * sizeof(double));
     o->pair_upper = calloc((size_t)o->n_pairs + 1, 1);
-    if (!o->point_pairs || !o->point_cost || !o->pair_upper)
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    /* a point with k parts costs about k (k + 1) / 2 block updates plus k gradient rows */
-    o->point_cost[0] = 0;
-    for (int p = 0; p < o->n_quad; ++p) {
-        double k = (double)(W->row_start[p + 1] - W->row_start[p]);
-        o->point_cost[p + 1] = o->point_cost[p] + 0.5 * k * (k + 1) + k + 1;
-    }
+    if (!o->point_pairs || !o->pair_upper) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
 #pragma omp parallel for schedule(static)
     for (int p = 0; p < o->n_quad; ++p) {
         const double *X = d->quad_X + 3 * (size_t)p;
@@ -446,14 +454,10 @@ static sem_status setup_points(object *o, sem_error *err)
             int i = W->col[r];
             const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
             double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]};
-            double b[10], db[30];
-            sem_polynomial_basis(o->d->order, dX, b, db);
+            double b[10];
+            sem_polynomial_basis(o->d->order, dX, b, NULL);
             double w = W->val[r];
-            double *g = o->entry_grad + (size_t)r * m * 3;
-            for (int k = 0; k < m; ++k) {
-                o->entry_basis[(size_t)r * m + k] = w * b[k];
-                for (int e = 0; e < 3; ++e) g[k * 3 + e] = w * db[e * m + k];
-            }
+            for (int k = 0; k < m; ++k) o->entry_basis[(size_t)r * m + k] = w * b[k];
             for (int r2 = r0; r2 < r1; ++r2)
                 o->point_pairs[pp++] = o->pair_lookup[(size_t)i * o->n_parts + W->col[r2]];
         }
@@ -462,6 +466,110 @@ static sem_status setup_points(object *o, sem_error *err)
         for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
             for (int r2 = r; r2 < W->row_start[p + 1]; ++r2)
                 o->pair_upper[o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]]] = 1;
+    return SEM_OK;
+}
+
+/* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
+ * part's own basis, b(X - Xbar_i) with s = ref_X - Xbar_i, to the shared one, b(X - ref_X). */
+static void basis_shift(int m, const double s[3], double *T)
+{
+    memset(T, 0, (size_t)m * m * sizeof(double));
+    for (int k = 0; k < m; ++k) T[k * m + k] = 1.0;
+    for (int e = 0; e < 3; ++e) T[(1 + e) * m] = s[e];
+    if (m < 10) return;
+    /* b4..b9 = xy, xz, yz, x^2, y^2, z^2 */
+    static const int pa[6] = {0, 0, 1, 0, 1, 2}, pb[6] = {1, 2, 2, 0, 1, 2};
+    for (int q = 0; q < 6; ++q) {
+        double *row = T + (size_t)(4 + q) * m;
+        int a = pa[q], b = pb[q];
+        row[0] = s[a] * s[b];
+        row[1 + a] += s[b];
+        row[1 + b] += s[a];
+    }
+}
+
+/* The stiffness in one shared basis. With Eq. 15, a part's contribution to F at point p
+ * is w_i (grad b(X_p - Xbar_i))^T z_i = w_i (grad b(X_p - ref))^T (T_i^T z_i): every part
+ * at p shares the point's D_p = grad b(X_p - ref), so a part pair's block is
+ *   Kz_ab = sum_p w_a w_b N_p,   N_p = vol_p D_p^T (d2psi/dF2) D_p (per coordinate pair),
+ * N_p is computed once per point (not once per part pair), and Kz_ab = Kz_ba is symmetric.
+ * The change of basis goes into Pi: pi_shared_i = T_i^T Pi_i. The constant basis function
+ * has no gradient, so only rows 1..m-1 take part. */
+static sem_status setup_stiffness(object *o, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *W = &d->W;
+    int m = o->m, ma = m - 1;
+    o->ma = ma;
+    /* the shared origin: the volume centroid (keeps the monomials small) */
+    double vsum = 0;
+    for (int k = 0; k < 3; ++k) o->ref_X[k] = 0;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double v = d->quad_volume[p];
+        vsum += v;
+        for (int k = 0; k < 3; ++k) o->ref_X[k] += v * d->quad_X[3 * (size_t)p + k];
+    }
+    for (int k = 0; k < 3; ++k) o->ref_X[k] = vsum > 0 ? o->ref_X[k] / vsum : 0;
+    o->pi_shared = calloc((size_t)(o->n_parts > 0 ? o->n_parts : 1), sizeof(double *));
+    if (!o->pi_shared) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < o->n_parts; ++i) {
+        const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+        double sh[3] = {o->ref_X[0] - Xb[0], o->ref_X[1] - Xb[1], o->ref_X[2] - Xb[2]}, T[100];
+        basis_shift(m, sh, T);
+        size_t n = gsize(o, d->part_origin[i]);
+        double *ps = o->pi_shared[i] = calloc((size_t)ma * n + 1, sizeof(double));
+        if (!ps) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int l = 1; l < m; ++l)
+            for (int k = 0; k < m; ++k) {
+                double t = T[k * m + l];
+                if (t == 0) continue;
+                const double *src = o->pi_dense[i] + (size_t)k * n;
+                double *dst = ps + (size_t)(l - 1) * n;
+                for (size_t j = 0; j < n; ++j) dst[j] += t * src[j];
+            }
+    }
+    o->point_D = malloc(((size_t)o->n_quad * ma * 3 + 1) * sizeof(double));
+    if (!o->point_D) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int p = 0; p < o->n_quad; ++p) {
+        const double *X = d->quad_X + 3 * (size_t)p;
+        double y[3] = {X[0] - o->ref_X[0], X[1] - o->ref_X[1], X[2] - o->ref_X[2]}, db[30];
+        sem_polynomial_basis(o->d->order, y, NULL, db);
+        double *D = o->point_D + (size_t)p * ma * 3;
+        for (int k = 1; k < m; ++k)
+            for (int e = 0; e < 3; ++e) D[(k - 1) * 3 + e] = db[e * m + k];
+    }
+    /* the points of each upper part pair, in point order, with w_a w_b */
+    o->plist_start = calloc((size_t)o->n_pairs + 1, sizeof(int));
+    o->plist_cursor = malloc(((size_t)o->n_pairs + 1) * sizeof(int));
+    if (!o->plist_start || !o->plist_cursor) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int p = 0; p < o->n_quad; ++p)
+        for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
+            for (int r2 = r; r2 < W->row_start[p + 1]; ++r2)
+                o->plist_start[o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]] + 1]++;
+    for (int k = 0; k < o->n_pairs; ++k) o->plist_start[k + 1] += o->plist_start[k];
+    size_t nl = (size_t)o->plist_start[o->n_pairs];
+    o->plist_point = malloc((nl + 1) * sizeof(int));
+    o->plist_w = malloc((nl + 1) * sizeof(double));
+    if (!o->plist_point || !o->plist_w) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    memcpy(o->plist_cursor, o->plist_start, (size_t)o->n_pairs * sizeof(int));
+    for (int p = 0; p < o->n_quad; ++p)
+        for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
+            for (int r2 = r; r2 < W->row_start[p + 1]; ++r2) {
+                int pr = o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]];
+                o->plist_point[o->plist_cursor[pr]] = p;
+                o->plist_w[o->plist_cursor[pr]++] = W->val[r] * W->val[r2];
+            }
+    int n3 = 3 * ma;
+    o->n_packed = n3 * (n3 + 1) / 2;
+    /* points are assembled in chunks so that N stays small (27 MB at most) */
+    o->chunk = o->n_quad < 8192 ? (o->n_quad > 0 ? o->n_quad : 1) : 8192;
+    o->N_chunk = malloc(((size_t)o->chunk * o->n_packed + 1) * sizeof(double));
+    o->Kz = malloc(((size_t)o->n_pairs * n3 * n3 + 1) * sizeof(double));
+    o->Kz_packed = o->chunk < o->n_quad
+                       ? malloc(((size_t)o->n_pairs * o->n_packed + 1) * sizeof(double))
+                       : calloc(1, sizeof(double));
+    if (!o->N_chunk || !o->Kz || !o->Kz_packed)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the stiffness blocks");
     return SEM_OK;
 }
 
@@ -834,7 +942,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->pinned = calloc((size_t)o->n_ctrl, 1);
     o->free_index = malloc((size_t)o->n_ctrl * sizeof(int));
     o->z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
-    o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
+    o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double)); /* room for ma rows */
     if (!o->q || !o->v || !o->q0 || !o->f_gravity || !o->point_material || !o->point_rho_vol ||
         !o->pinned || !o->free_index || !o->z || !o->grad_z) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
@@ -907,22 +1015,12 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = setup_groups(o, err)) != SEM_OK) goto fail;
     if ((st = setup_pairs(o, err)) != SEM_OK) goto fail;
     if ((st = setup_points(o, err)) != SEM_OK) goto fail;
+    if ((st = setup_stiffness(o, err)) != SEM_OK) goto fail;
     if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
-    size_t kz = (size_t)o->n_pairs * 9 * o->m * o->m;
-    o->Kz = malloc((kz + 1) * sizeof(double));
-    o->Kz_thread = malloc(((size_t)o->nthreads * kz + 1) * sizeof(double));
-    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->m * 3 + 1) * sizeof(double));
-    o->max_row = 1;
-    for (int p = 0; p < o->n_quad; ++p)
-        if (d->W.row_start[p + 1] - d->W.row_start[p] > o->max_row) o->max_row = d->W.row_start[p + 1] - d->W.row_start[p];
-    o->hg_thread = malloc((size_t)o->nthreads * o->max_row * 9 * 3 * o->m * sizeof(double));
+    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
-    if (!o->hg_thread || !o->qc) {
-        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if (!o->Kz || !o->Kz_thread || !o->grad_z_thread) {
+    if (!o->qc || !o->grad_z_thread) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -1007,9 +1105,8 @@ static double error_term(object *o, const double *q, double *grad)
 }
 
 /* Elastic energy, gradient in q (if grad_q) and, if want_hessian, K_blocks. */
-/* The block updates below are element-wise (no reordered sums, and ISO C mode keeps the
- * compiler from contracting to FMA), so every clone gives the same bits; the vector
- * clones run the per-point Hessian about twice as fast. */
+/* The kernels below are element-wise (no reordered sums, and ISO C mode keeps the compiler
+ * from contracting to FMA), so every clone gives the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
     !defined(SEM_NO_CLONES)
 #define SEM_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -1017,61 +1114,39 @@ static double error_term(object *o, const double *q, double *grad)
 #define SEM_VECTOR_CLONES
 #endif
 
-/* Adds one quadrature point's Hessian to the z-space blocks of its part pairs (b >= a;
- * the mirror blocks are filled after the sum). k parts, grad = their k entry gradients
- * (m x 3 each, weight included), pairs = the point's k x k part-pair indices, H = the
- * PSD-projected d2psi/dF2 (9 x 9), HG = scratch of k x 9 x 3m. */
+/* One point's N = vol D^T (d2psi/dF2) D, rows and columns (d, k) (coordinate d, basis
+ * function k = 1..ma), as the packed upper triangle (row by row) of the 3ma x 3ma matrix:
+ * N[(d,k),(d',k')] = vol sum_{e,e'} D[k][e] H[(d,e),(d',e')] D[k'][e']. */
 SEM_VECTOR_CLONES
-static void point_hessian(int k, int m, double vol, const double *H, const double *grad,
-                          const int *pairs, double *Kt, double *HG)
+static void point_stiffness(int ma, double vol, const double *H, const double *D, double *N)
 {
-    int m3 = 3 * m;
-    /* HG_b[(d,e)][(d',k')] = sum_e' H[(d,e),(d',e')] g_b[k'][e'], once per part b */
-    for (int rb = 0; rb < k; ++rb) {
-        const double *gb = grad + (size_t)rb * m * 3;
-        double *HGb = HG + (size_t)rb * 9 * m3;
-        for (int de = 0; de < 9; ++de)
-            for (int d2 = 0; d2 < 3; ++d2) {
-                const double *h = H + de * 9 + d2 * 3;
-                for (int k2 = 0; k2 < m; ++k2)
-                    HGb[de * m3 + d2 * m + k2] =
-                        h[0] * gb[k2 * 3 + 0] + h[1] * gb[k2 * 3 + 1] + h[2] * gb[k2 * 3 + 2];
-            }
-    }
-    for (int ra = 0; ra < k; ++ra) {
-        const double *ga = grad + (size_t)ra * m * 3;
-        for (int rb = ra; rb < k; ++rb) {
-            const double *HGb = HG + (size_t)rb * 9 * m3;
-            /* Kz[(d,k)][(d',k')] += vol sum_e ga[k][e] HG[(d,e)][(d',k')] */
-            double *K = Kt + (size_t)pairs[ra * k + rb] * m3 * m3;
-            for (int d1 = 0; d1 < 3; ++d1)
-                for (int k1 = 0; k1 < m; ++k1) {
-                    double a0 = vol * ga[k1 * 3 + 0], a1 = vol * ga[k1 * 3 + 1], a2 = vol * ga[k1 * 3 + 2];
-                    if (a0 == 0 && a1 == 0 && a2 == 0) continue;
-                    const double *h0 = HGb + (d1 * 3 + 0) * m3, *h1 = HGb + (d1 * 3 + 1) * m3,
-                                 *h2 = HGb + (d1 * 3 + 2) * m3;
-                    double *Krow = K + (size_t)(d1 * m + k1) * m3;
-                    for (int c = 0; c < m3; ++c) Krow[c] += a0 * h0[c] + a1 * h1[c] + a2 * h2[c];
-                }
+    int n3 = 3 * ma;
+    double HD[9 * 27]; /* HD[(d,e)][(d',k')] = sum_e' H[(d,e),(d',e')] D[k'][e'] */
+    for (int de = 0; de < 9; ++de)
+        for (int d2 = 0; d2 < 3; ++d2) {
+            const double *h = H + de * 9 + d2 * 3;
+            for (int k2 = 0; k2 < ma; ++k2)
+                HD[de * n3 + d2 * ma + k2] = h[0] * D[k2 * 3 + 0] + h[1] * D[k2 * 3 + 1] + h[2] * D[k2 * 3 + 2];
         }
-    }
+    int idx = 0;
+    for (int d1 = 0; d1 < 3; ++d1)
+        for (int k1 = 0; k1 < ma; ++k1) {
+            double a0 = vol * D[k1 * 3 + 0], a1 = vol * D[k1 * 3 + 1], a2 = vol * D[k1 * 3 + 2];
+            const double *h0 = HD + (d1 * 3 + 0) * n3, *h1 = HD + (d1 * 3 + 1) * n3, *h2 = HD + (d1 * 3 + 2) * n3;
+            for (int j = d1 * ma + k1; j < n3; ++j) N[idx++] = a0 * h0[j] + a1 * h1[j] + a2 * h2[j];
+        }
 }
 
-/* First point of thread t's share of the points when nt threads split the work by cost
- * (prefix sums in cost): deterministic for a fixed thread count, and balanced although a
- * point's work grows with the square of its number of parts. */
-static int cost_split(const double *cost, int n, int t, int nt)
+/* acc += sum over the pair's entries [e0, e1) of w_e N_{point e} (points from c0 on). */
+SEM_VECTOR_CLONES
+static void pair_sum(int np, const int *point, const double *w, int e0, int e1, int c0,
+                     const double *N, double *acc)
 {
-    if (t <= 0) return 0;
-    if (t >= nt) return n;
-    double target = cost[n] * t / nt;
-    int lo = 0, hi = n;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        if (cost[mid] < target) lo = mid + 1;
-        else hi = mid;
+    for (int e = e0; e < e1; ++e) {
+        const double *n = N + (size_t)(point[e] - c0) * np;
+        double we = w[e];
+        for (int x = 0; x < np; ++x) acc[x] += we * n[x];
     }
-    return lo;
 }
 
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
@@ -1079,12 +1154,31 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
-    int m = o->m, m3 = 3 * m;
-    size_t nz = (size_t)o->n_parts * m * 3;
-    size_t kz = (size_t)o->n_pairs * m3 * m3;
-    size_t bs = (size_t)m3 * m3;
-    /* z = Pi Q, with Q centred (translation invariance; see centered) */
-    sem_csr_multiply(&d->Pi, centered(o, q), 3, o->z);
+    int ma = o->ma, n3 = 3 * ma, np = o->n_packed;
+    size_t nz = (size_t)o->n_parts * ma * 3;
+    size_t bs = (size_t)n3 * n3;
+    /* z_i = pi_shared_i Q (shared-basis coefficients), with Q centred (translation
+     * invariance; see centered) */
+    const double *qc = centered(o, q);
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = d->part_origin[i];
+        size_t n = gsize(o, g);
+        const int *ctrl = o->group_ctrl + o->group_start[g];
+        double *zi = o->z + (size_t)i * ma * 3;
+        for (int k = 0; k < ma; ++k) {
+            const double *row = o->pi_shared[i] + (size_t)k * n;
+            double s0 = 0, s1 = 0, s2 = 0;
+            for (size_t j = 0; j < n; ++j) {
+                const double *x = qc + 3 * (size_t)ctrl[j];
+                s0 += row[j] * x[0];
+                s1 += row[j] * x[1];
+                s2 += row[j] * x[2];
+            }
+            zi[k * 3 + 0] = s0;
+            zi[k * 3 + 1] = s1;
+            zi[k * 3 + 2] = s2;
+        }
+    }
     int nth = o->nthreads;
     double energy_total = 0;
     int bad = 0;
@@ -1093,81 +1187,83 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
 #pragma omp parallel num_threads(nth) reduction(| : bad)
     {
         int t = omp_get_thread_num();
-        int nt = omp_get_num_threads();
         double *gz = o->grad_z_thread + (size_t)t * nz;
-        double *Kt = o->Kz_thread + (size_t)t * kz;
         memset(gz, 0, nz * sizeof(double));
-        if (want_hessian)
-            for (int pr = 0; pr < o->n_pairs; ++pr)
-                if (o->pair_upper[pr]) memset(Kt + (size_t)pr * bs, 0, bs * sizeof(double));
         double energy = 0;
-        /* static contiguous shares of equal cost: deterministic for a fixed thread count */
-        int p0 = cost_split(o->point_cost, o->n_quad, t, nt);
-        int p1 = cost_split(o->point_cost, o->n_quad, t + 1, nt);
-        double *HG = o->hg_thread + (size_t)t * o->max_row * 9 * m3;
-        for (int p = p0; p < p1; ++p) {
-            int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-            double F[9] = {0};
-            for (int r = r0; r < r1; ++r) {
-                const double *g = o->entry_grad + (size_t)r * m * 3;
-                const double *zi = o->z + (size_t)W->col[r] * m * 3;
-                for (int k = 0; k < m; ++k)
-                    for (int dd = 0; dd < 3; ++dd) {
-                        double zk = zi[k * 3 + dd];
-                        F[dd * 3 + 0] += g[k * 3 + 0] * zk;
-                        F[dd * 3 + 1] += g[k * 3 + 1] * zk;
-                        F[dd * 3 + 2] += g[k * 3 + 2] * zk;
+        for (int c0 = 0; c0 < o->n_quad; c0 += o->chunk) {
+            int c1 = o->n_quad - c0 > o->chunk ? c0 + o->chunk : o->n_quad;
+            /* per point: F, psi, P, and N_p (static shares: deterministic for a fixed
+             * thread count) */
+#pragma omp for schedule(static)
+            for (int p = c0; p < c1; ++p) {
+                int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+                const double *D = o->point_D + (size_t)p * ma * 3;
+                double zb[27] = {0}; /* sum_i w_i z_i */
+                for (int r = r0; r < r1; ++r) {
+                    const double *zi = o->z + (size_t)W->col[r] * ma * 3;
+                    double w = W->val[r];
+                    for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
+                }
+                double F[9];
+                for (int dd = 0; dd < 3; ++dd)
+                    for (int e = 0; e < 3; ++e) {
+                        double f = 0;
+                        for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
+                        F[dd * 3 + e] = f;
                     }
-            }
-            double P[9], H[81];
-            double vol = d->quad_volume[p];
-            double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
-            if (!isfinite(psi)) {
-                bad = 1;
-                continue;
-            }
-            energy += vol * psi;
-            for (int r = r0; r < r1; ++r) {
-                const double *g = o->entry_grad + (size_t)r * m * 3;
-                double *gzi = gz + (size_t)W->col[r] * m * 3;
-                for (int k = 0; k < m; ++k)
+                double P[9], H[81];
+                double vol = d->quad_volume[p];
+                double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
+                if (!isfinite(psi)) {
+                    bad = 1;
+                    if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
+                    continue;
+                }
+                energy += vol * psi;
+                /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
+                double v[27];
+                for (int k = 0; k < ma; ++k)
                     for (int dd = 0; dd < 3; ++dd)
-                        gzi[k * 3 + dd] += vol * (P[dd * 3 + 0] * g[k * 3 + 0] + P[dd * 3 + 1] * g[k * 3 + 1] +
-                                                  P[dd * 3 + 2] * g[k * 3 + 2]);
+                        v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
+                                               P[dd * 3 + 2] * D[k * 3 + 2]);
+                for (int r = r0; r < r1; ++r) {
+                    double *gzi = gz + (size_t)W->col[r] * ma * 3;
+                    double w = W->val[r];
+                    for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
+                }
+                if (!want_hessian) continue;
+                sem_project_psd_9x9(H);
+                point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
             }
             if (!want_hessian) continue;
-            sem_project_psd_9x9(H);
-            point_hessian(r1 - r0, m, vol, H, o->entry_grad + (size_t)r0 * m * 3,
-                          o->point_pairs + o->entry_pair_offset[p], Kt, HG);
-        }
-        thread_energy[t] = energy;
-        if (want_hessian) {
-            /* reduce the threads' blocks in thread order (deterministic), split by pair;
-             * then mirror: Kz(b,a) = Kz(a,b)^T for a < b (W rows list parts in increasing
-             * order) */
-#pragma omp barrier
-#pragma omp for schedule(static)
+            /* per upper part pair: Kz_ab += sum_p w_a w_b N_p over the chunk's points, each
+             * pair summed by one thread in point order (deterministic for any thread count) */
+            int first = c0 == 0, last = c1 == o->n_quad;
+#pragma omp for schedule(dynamic, 8)
             for (int pr = 0; pr < o->n_pairs; ++pr) {
                 if (!o->pair_upper[pr]) continue;
-                double *dst = o->Kz + (size_t)pr * bs;
-                memcpy(dst, o->Kz_thread + (size_t)pr * bs, bs * sizeof(double));
-                for (int tt = 1; tt < nt; ++tt) {
-                    const double *src = o->Kz_thread + (size_t)tt * kz + (size_t)pr * bs;
-                    for (size_t x = 0; x < bs; ++x) dst[x] += src[x];
+                double acc[378];
+                if (first) {
+                    memset(acc, 0, (size_t)np * sizeof(double));
+                    o->plist_cursor[pr] = o->plist_start[pr];
+                } else {
+                    memcpy(acc, o->Kz_packed + (size_t)pr * np, (size_t)np * sizeof(double));
                 }
-            }
-#pragma omp for schedule(static)
-            for (int pr = 0; pr < o->n_pairs; ++pr) {
-                int a = o->pair_a[pr], b = o->pair_b[pr];
-                if (a <= b) continue;
-                int up = o->pair_lookup[(size_t)b * o->n_parts + a];
-                if (!o->pair_upper[up]) continue;
-                const double *src = o->Kz + (size_t)up * bs;
-                double *dst = o->Kz + (size_t)pr * bs;
-                for (int x = 0; x < m3; ++x)
-                    for (int y = 0; y < m3; ++y) dst[x * m3 + y] = src[y * m3 + x];
+                int e0 = o->plist_cursor[pr], e1 = e0, end = o->plist_start[pr + 1];
+                while (e1 < end && o->plist_point[e1] < c1) e1++;
+                pair_sum(np, o->plist_point, o->plist_w, e0, e1, c0, o->N_chunk, acc);
+                o->plist_cursor[pr] = e1;
+                if (!last) {
+                    memcpy(o->Kz_packed + (size_t)pr * np, acc, (size_t)np * sizeof(double));
+                    continue;
+                }
+                double *K = o->Kz + (size_t)pr * bs;
+                int idx = 0;
+                for (int i = 0; i < n3; ++i)
+                    for (int j = i; j < n3; ++j) K[i * n3 + j] = K[j * n3 + i] = acc[idx++];
             }
         }
+        thread_energy[t] = energy;
     }
     for (int t = 0; t < nth; ++t) energy_total += thread_energy[t];
     free(thread_energy);
@@ -1180,7 +1276,24 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     memcpy(o->grad_z, o->grad_z_thread, nz * sizeof(double));
     for (int t = 1; t < nth; ++t)
         for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_thread[(size_t)t * nz + k];
-    if (grad_q) sem_csr_multiply_transpose(&d->Pi, o->grad_z, 3, grad_q);
+    if (grad_q) {
+        memset(grad_q, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
+        for (int i = 0; i < o->n_parts; ++i) {
+            int g = d->part_origin[i];
+            size_t n = gsize(o, g);
+            const int *ctrl = o->group_ctrl + o->group_start[g];
+            const double *gzi = o->grad_z + (size_t)i * ma * 3;
+            for (int k = 0; k < ma; ++k) {
+                const double *row = o->pi_shared[i] + (size_t)k * n;
+                for (size_t j = 0; j < n; ++j) {
+                    double *y = grad_q + 3 * (size_t)ctrl[j];
+                    y[0] += row[j] * gzi[k * 3 + 0];
+                    y[1] += row[j] * gzi[k * 3 + 1];
+                    y[2] += row[j] * gzi[k * 3 + 2];
+                }
+            }
+        }
+    }
     if (!want_hessian) return SEM_OK;
     /* K_q blocks = sum over part pairs Pi_a^T Kz Pi_b per coordinate pair. The small dgemm
      * calls run inside our OpenMP threads: OpenBLAS's own threads would only oversubscribe
@@ -1192,12 +1305,13 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     openblas_set_num_threads(1);
 #pragma omp parallel num_threads(nth) reduction(| : fail)
     {
-        /* Block(ga,gb) = sum_a Pi_a^T (sum_b Kz_ab Pi_b): the inner sum first, so the
-         * expensive product with Pi_a^T is done once per part a, not per pair. Kz_ab is
-         * read as a (3m x 3) x m matrix, rows (d, k, d'), so the inner product is one call:
-         * U[(d,k,d')][j] = sum_k' Kz[(d,k),(d',k')] Pi_b[k'][j]. Pairs without a shared
-         * quadrature point (only in the error matrix's pattern) have no stiffness. */
-        double *U = malloc(9 * (size_t)m * mg * sizeof(double));
+        /* Block(ga,gb) = sum_a Pi_a^T (sum_b Kz_ab Pi_b) with the shared-basis Pi: the inner
+         * sum first, so the expensive product with Pi_a^T is done once per part a, not per
+         * pair. Kz_ab is read as a (3ma x 3) x ma matrix, rows (d, k, d'), so the inner
+         * product is one call: U[(d,k,d')][j] = sum_k' Kz[(d,k),(d',k')] Pi_b[k'][j].
+         * Kz_ba = Kz_ab (symmetric) is stored once, under the pair a <= b. Pairs without a
+         * shared quadrature point (only in the error matrix's pattern) have no stiffness. */
+        double *U = malloc(9 * (size_t)ma * mg * sizeof(double));
         if (!U) fail = 1;
 #pragma omp for schedule(dynamic, 4)
         for (int g = 0; g < o->n_gpairs; ++g) {
@@ -1213,14 +1327,14 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                     int pr = o->gpair_pairs[k], b = o->pair_b[pr];
                     int up = a <= b ? pr : o->pair_lookup[(size_t)b * o->n_parts + a];
                     if (!o->pair_upper[up]) continue;
-                    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, 3 * m3, nb, m, 1.0,
-                                o->Kz + (size_t)pr * bs, m, o->pi_dense[b], nb, any ? 1.0 : 0.0, U, nb);
+                    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, 3 * n3, nb, ma, 1.0,
+                                o->Kz + (size_t)up * bs, ma, o->pi_shared[b], nb, any ? 1.0 : 0.0, U, nb);
                     any = 1;
                 }
                 if (!any) continue;
                 for (int dd = 0; dd < 9; ++dd)
-                    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[a], na,
-                                U + (size_t)((dd / 3) * m * 3 + dd % 3) * nb, 3 * nb, 1.0,
+                    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, ma, 1.0, o->pi_shared[a], na,
+                                U + (size_t)((dd / 3) * ma * 3 + dd % 3) * nb, 3 * nb, 1.0,
                                 blk + (size_t)dd * na * nb, nb);
             }
         }
