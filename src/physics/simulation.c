@@ -84,7 +84,8 @@ typedef struct object {
     size_t *gpair_offset;      /* scalar block offsets (size |Ga||Gb|), n_gpairs + 1 */
     int *part_pair_gpair;      /* per part pair */
     int *gpair_pairs_start, *gpair_pairs; /* part pairs per group pair */
-    double *K_blocks;          /* 9 * gpair_offset[n] : sub-block (d,d') at 9*off + (3d+d')*size */
+    double *K_blocks;          /* 9 * gpair_offset[n] : sub-block (d,d') at 9*off + (3d+d')*size;
+                                * formed for group pairs ga <= gb only (symmetry) */
     double *M_blocks;          /* gpair_offset[n] */
     double *E_blocks;          /* error matrix, gpair_offset[n] */
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
@@ -752,7 +753,9 @@ static sem_status setup_constant_blocks(object *o, sem_error *err)
     return SEM_OK;
 }
 
-/* CSC pattern of the free system (upper triangle) and the map from block entries. */
+/* CSC pattern of the free system (upper triangle) and the map from block entries. The
+ * system is symmetric and its blocks are formed for group pairs ga <= gb only: an entry of
+ * such a block maps to its own position or to its mirror's; blocks ga > gb map nowhere. */
 static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *err)
 {
     int nf = 3 * o->n_free;
@@ -794,9 +797,14 @@ static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *er
                             continue;
                         }
                         int r = 3 * fa + d1, c = 3 * fb + d2;
-                        if (r > c) {
+                        if (ga > gb || (ga == gb && r > c)) {
                             if (pass == 1) o->map[idx] = -1;
                             continue;
+                        }
+                        if (r > c) {
+                            int x = r;
+                            r = c;
+                            c = x;
                         }
                         if (pass == 0)
                             count[c + 1]++;
@@ -1310,12 +1318,13 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
          * pair. Kz_ab is read as a (3ma x 3) x ma matrix, rows (d, k, d'), so the inner
          * product is one call: U[(d,k,d')][j] = sum_k' Kz[(d,k),(d',k')] Pi_b[k'][j].
          * Kz_ba = Kz_ab (symmetric) is stored once, under the pair a <= b. Pairs without a
-         * shared quadrature point (only in the error matrix's pattern) have no stiffness. */
+         * shared quadrature point (only in the error matrix's pattern) have no stiffness.
+         * K is symmetric, so only group pairs ga <= gb are formed (see setup_system). */
         double *U = malloc(9 * (size_t)ma * mg * sizeof(double));
         if (!U) fail = 1;
 #pragma omp for schedule(dynamic, 4)
         for (int g = 0; g < o->n_gpairs; ++g) {
-            if (!U) continue;
+            if (!U || o->gpair_a[g] > o->gpair_b[g]) continue;
             int na = (int)gsize(o, o->gpair_a[g]), nb = (int)gsize(o, o->gpair_b[g]);
             double *blk = o->K_blocks + 9 * o->gpair_offset[g];
             memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
@@ -1362,12 +1371,18 @@ static void blocks_multiply(const object *o, double cM, double cE, double cK, do
                 size_t e = la * nb + lb;
                 double s = cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
                 for (int d = 0; d < 3; ++d) ya[d] += s * xb[d];
-                if (cK != 0 || cD != 0)
+                if ((cK != 0 || cD != 0) && ga <= gb) {
+                    /* K is kept for ga <= gb; block (gb, ga) is its transpose */
+                    const double *xa = x + 3 * (size_t)ca[la];
+                    double *yb = y + 3 * (size_t)cb[lb];
                     for (int d1 = 0; d1 < 3; ++d1)
                         for (int d2 = 0; d2 < 3; ++d2) {
                             size_t idx = 9 * off + (size_t)(d1 * 3 + d2) * na * nb + e;
-                            ya[d1] += (cK * o->K_blocks[idx] + cD * o->K0_blocks[idx]) * xb[d2];
+                            double k = cK * o->K_blocks[idx] + cD * o->K0_blocks[idx];
+                            ya[d1] += k * xb[d2];
+                            if (ga < gb) yb[d2] += k * xa[d1];
                         }
+                }
             }
         }
     }
@@ -1380,6 +1395,7 @@ static void fill_system(object *o, double cM, double cE, double cK, double cD)
     /* every block entry has its own position (or none): the group pairs are independent */
 #pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
     for (int g = 0; g < o->n_gpairs; ++g) {
+        if (o->gpair_a[g] > o->gpair_b[g]) continue; /* mapped nowhere (see setup_system) */
         size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
         size_t off = o->gpair_offset[g], n = na * nb;
         for (int dd = 0; dd < 9; ++dd) {
