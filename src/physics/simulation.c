@@ -84,8 +84,9 @@ typedef struct object {
     size_t *gpair_offset;      /* scalar block offsets (size |Ga||Gb|), n_gpairs + 1 */
     int *part_pair_gpair;      /* per part pair */
     int *gpair_pairs_start, *gpair_pairs; /* part pairs per group pair */
-    double *K_blocks;          /* 9 * gpair_offset[n] : sub-block (d,d') at 9*off + (3d+d')*size;
-                                * formed for group pairs ga <= gb only (symmetry) */
+    double *K_blocks;          /* 9 * gpair_offset[n]: entry (la, lb) of sub-block (d,d') at
+                                * 9*off + (9 la + 3d + d') |Gb| + lb; formed for group
+                                * pairs ga <= gb only (symmetry) */
     double *M_blocks;          /* gpair_offset[n] */
     double *E_blocks;          /* error matrix, gpair_offset[n] */
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
@@ -791,7 +792,7 @@ static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *er
                     int fb = o->free_index[o->group_ctrl[o->group_start[gb] + lb]];
                     for (int dd = 0; dd < 9; ++dd) {
                         int d1 = dd / 3, d2 = dd % 3;
-                        size_t idx = 9 * o->gpair_offset[g] + (size_t)dd * na * nb + la * nb + lb;
+                        size_t idx = 9 * o->gpair_offset[g] + (la * 9 + (size_t)dd) * nb + lb;
                         if (fa < 0 || fb < 0) {
                             if (pass == 1) o->map[idx] = -1;
                             continue;
@@ -1265,10 +1266,16 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                     memcpy(o->Kz_packed + (size_t)pr * np, acc, (size_t)np * sizeof(double));
                     continue;
                 }
+                /* full matrix, rows (k, d), columns (d', k') (see the projection below) */
                 double *K = o->Kz + (size_t)pr * bs;
                 int idx = 0;
-                for (int i = 0; i < n3; ++i)
-                    for (int j = i; j < n3; ++j) K[i * n3 + j] = K[j * n3 + i] = acc[idx++];
+                for (int i = 0; i < n3; ++i) {
+                    int ri = (i % ma) * 3 + i / ma;
+                    for (int j = i; j < n3; ++j) {
+                        int rj = (j % ma) * 3 + j / ma;
+                        K[ri * n3 + j] = K[rj * n3 + i] = acc[idx++];
+                    }
+                }
             }
         }
         thread_energy[t] = energy;
@@ -1315,8 +1322,11 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     {
         /* Block(ga,gb) = sum_a Pi_a^T (sum_b Kz_ab Pi_b) with the shared-basis Pi: the inner
          * sum first, so the expensive product with Pi_a^T is done once per part a, not per
-         * pair. Kz_ab is read as a (3ma x 3) x ma matrix, rows (d, k, d'), so the inner
-         * product is one call: U[(d,k,d')][j] = sum_k' Kz[(d,k),(d',k')] Pi_b[k'][j].
+         * pair. Kz_ab (rows (k, d), columns (d', k')) is read as a (3ma x 3) x ma matrix,
+         * rows (k, d, d'), so the inner product is one call:
+         * U[(k,d,d')][j] = sum_k' Kz[(k,d),(d',k')] Pi_b[k'][j]; U is then an ma x 9|Gb|
+         * matrix, and Pi_a^T U is one call whose rows (la) hold the 9 sub-block rows side by
+         * side, the layout of K_blocks.
          * Kz_ba = Kz_ab (symmetric) is stored once, under the pair a <= b. Pairs without a
          * shared quadrature point (only in the error matrix's pattern) have no stiffness.
          * K is symmetric, so only group pairs ga <= gb are formed (see setup_system). */
@@ -1341,10 +1351,8 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                     any = 1;
                 }
                 if (!any) continue;
-                for (int dd = 0; dd < 9; ++dd)
-                    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, ma, 1.0, o->pi_shared[a], na,
-                                U + (size_t)((dd / 3) * ma * 3 + dd % 3) * nb, 3 * nb, 1.0,
-                                blk + (size_t)dd * na * nb, nb);
+                cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, 9 * nb, ma, 1.0, o->pi_shared[a], na,
+                            U, 9 * nb, 1.0, blk, 9 * nb);
             }
         }
         free(U);
@@ -1377,7 +1385,7 @@ static void blocks_multiply(const object *o, double cM, double cE, double cK, do
                     double *yb = y + 3 * (size_t)cb[lb];
                     for (int d1 = 0; d1 < 3; ++d1)
                         for (int d2 = 0; d2 < 3; ++d2) {
-                            size_t idx = 9 * off + (size_t)(d1 * 3 + d2) * na * nb + e;
+                            size_t idx = 9 * off + (la * 9 + (size_t)(d1 * 3 + d2)) * nb + lb;
                             double k = cK * o->K_blocks[idx] + cD * o->K0_blocks[idx];
                             ya[d1] += k * xb[d2];
                             if (ga < gb) yb[d2] += k * xa[d1];
@@ -1397,18 +1405,21 @@ static void fill_system(object *o, double cM, double cE, double cK, double cD)
     for (int g = 0; g < o->n_gpairs; ++g) {
         if (o->gpair_a[g] > o->gpair_b[g]) continue; /* mapped nowhere (see setup_system) */
         size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
-        size_t off = o->gpair_offset[g], n = na * nb;
-        for (int dd = 0; dd < 9; ++dd) {
-            int diag = dd / 3 == dd % 3;
-            const int *map = o->map + 9 * off + (size_t)dd * n;
-            const double *K = o->K_blocks + 9 * off + (size_t)dd * n;
-            const double *K0 = o->K0_blocks + 9 * off + (size_t)dd * n;
-            for (size_t e = 0; e < n; ++e) {
-                int pos = map[e];
-                if (pos < 0) continue;
-                double v = cK * K[e] + cD * K0[e];
-                if (diag) v += cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
-                val[pos] = v;
+        size_t off = o->gpair_offset[g];
+        for (size_t la = 0; la < na; ++la) {
+            const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
+            for (int dd = 0; dd < 9; ++dd) {
+                int diag = dd / 3 == dd % 3;
+                size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
+                const int *map = o->map + row;
+                const double *K = o->K_blocks + row, *K0 = o->K0_blocks + row;
+                for (size_t lb = 0; lb < nb; ++lb) {
+                    int pos = map[lb];
+                    if (pos < 0) continue;
+                    double v = cK * K[lb] + cD * K0[lb];
+                    if (diag) v += cM * Ms[lb] + 2.0 * cE * Es[lb];
+                    val[pos] = v;
+                }
             }
         }
     }
