@@ -16,6 +16,10 @@
  * of the 1800-dof mug). The caller's pattern positions are remapped once
  * (sem_linear_solver_remap); solves permute b and x.
  */
+/* The residual A x is summed in this many column shares, whatever the thread count, so
+ * it gives the same bits on any number of threads. */
+#define RESIDUAL_SHARES 4
+
 struct sem_linear_solver {
     int n;
     size_t nnz;
@@ -28,6 +32,8 @@ struct sem_linear_solver {
     cholmod_factor *L;
     double *dense; /* n x n column-major, lower triangle factor */
     double *work;  /* 3 n */
+    int col_split[RESIDUAL_SHARES + 1]; /* column shares of about equal entry counts */
+    double *partial;  /* RESIDUAL_SHARES x n: each share's part of A x */
     double last_factor_s;
 };
 
@@ -59,13 +65,15 @@ sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
     s->perm = malloc((nn + 1) * sizeof(int));
     s->remap = malloc((nz + 1) * sizeof(int));
     s->work = malloc((3 * nn + 1) * sizeof(double));
+    s->partial = malloc((RESIDUAL_SHARES * nn + 1) * sizeof(double));
     int *invp = malloc((nn + 1) * sizeof(int));
     int *count = calloc(nn + 1, sizeof(int));
     entry_key *keys = malloc((nz + 1) * sizeof *keys);
     cholmod_sparse *U = cholmod_allocate_sparse(nn, nn, nz, 1, 1, 1, CHOLMOD_PATTERN, &s->common);
     s->A = cholmod_allocate_sparse(nn, nn, nz, 1, 1, -1, CHOLMOD_REAL, &s->common);
     sem_status st = SEM_OK;
-    if (!s->perm || !s->remap || !s->work || !invp || !count || !keys || !U || !s->A) {
+    if (!s->perm || !s->remap || !s->work || !s->partial || !invp || !count ||
+        !keys || !U || !s->A) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %d x %d system", n, n);
         goto done;
     }
@@ -105,6 +113,11 @@ sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
         }
     }
     memset(s->A->x, 0, nz * sizeof(double));
+    for (int t = 0, c = 0; t <= RESIDUAL_SHARES; ++t) {
+        size_t target = nz * (size_t)t / RESIDUAL_SHARES;
+        while (c < n && (size_t)Ap[c] < target) ++c;
+        s->col_split[t] = t == RESIDUAL_SHARES ? n : c;
+    }
 done:
     free(invp);
     free(count);
@@ -134,6 +147,7 @@ void sem_linear_solver_destroy(sem_linear_solver *s)
     free(s->perm);
     free(s->remap);
     free(s->work);
+    free(s->partial);
     free(s);
 }
 
@@ -219,6 +233,59 @@ sem_status sem_linear_solver_factorize(sem_linear_solver *s, sem_error *err)
 
 static sem_status solve_once(sem_linear_solver *s, const double *b, double *x, sem_error *err);
 
+/* y = (columns col_split[t] .. col_split[t+1] of A) x, with A's stored lower triangle
+ * read symmetrically: a column's entries scatter (A_ic x_c into y_i), its mirror entries
+ * are a dot product (A_ic x_i into y_c) kept in four running sums. Columns are sorted, so
+ * a diagonal entry comes first. */
+static void share_product(const sem_linear_solver *s, int t, const double *x, double *y)
+{
+    const int *p = s->A->p, *ri = s->A->i;
+    const double *v = s->A->x;
+    memset(y, 0, (size_t)s->n * sizeof(double));
+    for (int c = s->col_split[t]; c < s->col_split[t + 1]; ++c) {
+        double xc = x[c], a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+        int k = p[c], end = p[c + 1];
+        if (k < end && ri[k] == c) {
+            y[c] += v[k] * xc;
+            ++k;
+        }
+        for (; k + 3 < end; k += 4) {
+            int i0 = ri[k], i1 = ri[k + 1], i2 = ri[k + 2], i3 = ri[k + 3];
+            y[i0] += v[k] * xc;
+            y[i1] += v[k + 1] * xc;
+            y[i2] += v[k + 2] * xc;
+            y[i3] += v[k + 3] * xc;
+            a0 += v[k] * x[i0];
+            a1 += v[k + 1] * x[i1];
+            a2 += v[k + 2] * x[i2];
+            a3 += v[k + 3] * x[i3];
+        }
+        for (; k < end; ++k) {
+            y[ri[k]] += v[k] * xc;
+            a0 += v[k] * x[ri[k]];
+        }
+        y[c] += (a0 + a1) + (a2 + a3);
+    }
+}
+
+/* r = b - A x: the column shares in parallel, each into its own vector, summed in share
+ * order. */
+static void residual(sem_linear_solver *s, const double *b, const double *x, double *r)
+{
+    size_t n = (size_t)s->n;
+#pragma omp parallel
+    {
+#pragma omp for schedule(static)
+        for (int t = 0; t < RESIDUAL_SHARES; ++t) share_product(s, t, x, s->partial + (size_t)t * n);
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; ++i) {
+            double ax = 0;
+            for (int t = 0; t < RESIDUAL_SHARES; ++t) ax += s->partial[(size_t)t * n + i];
+            r[i] = b[i] - ax;
+        }
+    }
+}
+
 /* One step of iterative refinement: SEM systems mix the mass matrix with the stiff error
  * term (Eq. 16), and the refinement recovers the digits the factorization loses, so that
  * conserved quantities (momentum) hold to round-off. Everything runs in the permuted order
@@ -231,16 +298,7 @@ sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double
     for (size_t k = 0; k < n; ++k) bp[k] = b[s->perm[k]];
     sem_status st = solve_once(s, bp, xp, err);
     if (st == SEM_OK) {
-        /* r = b - A x with the stored lower triangle (symmetric) */
-        memcpy(r, bp, n * sizeof(double));
-        const int *p = s->A->p, *ri = s->A->i;
-        const double *v = s->A->x;
-        for (size_t c = 0; c < n; ++c)
-            for (int k = p[c]; k < p[c + 1]; ++k) {
-                size_t i = (size_t)ri[k];
-                r[i] -= v[k] * xp[c];
-                if (i != c) r[c] -= v[k] * xp[i];
-            }
+        residual(s, bp, xp, r);
         st = solve_once(s, r, r, err);
         if (st == SEM_OK)
             for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k] + r[k];
