@@ -89,6 +89,8 @@ typedef struct object {
                                 * pairs ga <= gb only (symmetry) */
     double *M_blocks;          /* gpair_offset[n] */
     double *E_blocks;          /* error matrix, gpair_offset[n] */
+    int *me_start, *me_col;    /* M and E_blocks as one CSR pattern over control points */
+    double *me_M, *me_E;
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
     /* forces */
@@ -216,6 +218,10 @@ static void object_destroy(object *o)
     free(o->K_blocks);
     free(o->M_blocks);
     free(o->E_blocks);
+    free(o->me_start);
+    free(o->me_col);
+    free(o->me_M);
+    free(o->me_E);
     free(o->K0_blocks);
     free(o->f_gravity);
     free(o->pinned);
@@ -754,6 +760,44 @@ static sem_status setup_constant_blocks(object *o, sem_error *err)
     return SEM_OK;
 }
 
+/* M and E_blocks as CSR rows over control points, for products with them alone (the
+ * right-hand side and the error force of every step) run in parallel by rows. */
+static sem_status setup_constant_csr(object *o, sem_error *err)
+{
+    int nc = o->n_ctrl;
+    o->me_start = calloc((size_t)nc + 1, sizeof(int));
+    if (!o->me_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], nb = (int)gsize(o, o->gpair_b[g]);
+        for (int x = o->group_start[ga]; x < o->group_start[ga + 1]; ++x) o->me_start[o->group_ctrl[x] + 1] += nb;
+    }
+    for (int c = 0; c < nc; ++c) o->me_start[c + 1] += o->me_start[c];
+    size_t nnz = (size_t)o->me_start[nc];
+    o->me_col = malloc((nnz + 1) * sizeof(int));
+    o->me_M = malloc((nnz + 1) * sizeof(double));
+    o->me_E = malloc((nnz + 1) * sizeof(double));
+    int *fill = malloc(((size_t)nc + 1) * sizeof(int));
+    if (!o->me_col || !o->me_M || !o->me_E || !fill) {
+        free(fill);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    memcpy(fill, o->me_start, (size_t)nc * sizeof(int));
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], gb = o->gpair_b[g];
+        size_t na = gsize(o, ga), nb = gsize(o, gb), off = o->gpair_offset[g];
+        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
+        for (size_t la = 0; la < na; ++la)
+            for (size_t lb = 0; lb < nb; ++lb) {
+                int k = fill[ca[la]]++;
+                o->me_col[k] = cb[lb];
+                o->me_M[k] = o->M_blocks[off + la * nb + lb];
+                o->me_E[k] = o->E_blocks[off + la * nb + lb];
+            }
+    }
+    free(fill);
+    return SEM_OK;
+}
+
 /* CSC pattern of the free system (upper triangle) and the map from block entries. The
  * system is symmetric and its blocks are formed for group pairs ga <= gb only: an entry of
  * such a block maps to its own position or to its mirror's; blocks ga > gb map nowhere. */
@@ -892,7 +936,7 @@ static void compute_gravity(object *o, const double g[3])
 }
 
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
-                                   sem_error *err);
+                                   const double *system, sem_error *err);
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
 {
@@ -1026,6 +1070,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = setup_points(o, err)) != SEM_OK) goto fail;
     if ((st = setup_stiffness(o, err)) != SEM_OK) goto fail;
     if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
+    if ((st = setup_constant_csr(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
@@ -1036,7 +1081,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     compute_gravity(o, w->def.gravity);
     if (o->n_free > 0 && (st = setup_system(o, &w->def, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
-    if ((st = assemble_elastic(o, o->q0, 1, NULL, err)) != SEM_OK) goto fail;
+    if ((st = assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
     memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
     /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
     {
@@ -1158,8 +1203,12 @@ static void pair_sum(int np, const int *point, const double *w, int e0, int e1, 
     }
 }
 
+static void fill_gpair(object *o, int g, const double c[4], double *val);
+
+/* system: NULL, or the coefficients (cM, cE, cK, cD) of fill_system, whose work is then
+ * done group pair by group pair as each K block is formed (while it is in cache). */
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
-                                   sem_error *err)
+                                   const double *system, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
@@ -1317,6 +1366,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     size_t mg = max_group(o);
     int fail = 0;
     int blas_threads = openblas_get_num_threads();
+    double *val = system ? sem_linear_solver_values(o->solver) : NULL;
     openblas_set_num_threads(1);
 #pragma omp parallel num_threads(nth) reduction(| : fail)
     {
@@ -1354,6 +1404,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                 cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, 9 * nb, ma, 1.0, o->pi_shared[a], na,
                             U, 9 * nb, 1.0, blk, 9 * nb);
             }
+            if (system) fill_gpair(o, g, system, val);
         }
         free(U);
     }
@@ -1366,6 +1417,24 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
 static void blocks_multiply(const object *o, double cM, double cE, double cK, double cD,
                             const double *x, double *y)
 {
+    if (cK == 0 && cD == 0) {
+        /* mass and error matrix only: by rows in parallel */
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            double y0 = 0, y1 = 0, y2 = 0;
+            for (int k = o->me_start[c]; k < o->me_start[c + 1]; ++k) {
+                double v = cM * o->me_M[k] + 2.0 * cE * o->me_E[k];
+                const double *xb = x + 3 * (size_t)o->me_col[k];
+                y0 += v * xb[0];
+                y1 += v * xb[1];
+                y2 += v * xb[2];
+            }
+            y[3 * (size_t)c + 0] = y0;
+            y[3 * (size_t)c + 1] = y1;
+            y[3 * (size_t)c + 2] = y2;
+        }
+        return;
+    }
     memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
     for (int g = 0; g < o->n_gpairs; ++g) {
         int ga = o->gpair_a[g], gb = o->gpair_b[g];
@@ -1396,33 +1465,38 @@ static void blocks_multiply(const object *o, double cM, double cE, double cK, do
     }
 }
 
+/* The solver's values of group pair g (ga <= gb): c[0] M + c[1] 2 M_eps + c[2] K + c[3] K0.
+ * Every block entry has its own position (or none), so group pairs are independent. */
+static void fill_gpair(object *o, int g, const double c[4], double *val)
+{
+    if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see setup_system) */
+    size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
+    size_t off = o->gpair_offset[g];
+    for (size_t la = 0; la < na; ++la) {
+        const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
+        for (int dd = 0; dd < 9; ++dd) {
+            int diag = dd / 3 == dd % 3;
+            size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
+            const int *map = o->map + row;
+            const double *K = o->K_blocks + row, *K0 = o->K0_blocks + row;
+            for (size_t lb = 0; lb < nb; ++lb) {
+                int pos = map[lb];
+                if (pos < 0) continue;
+                double v = c[2] * K[lb] + c[3] * K0[lb];
+                if (diag) v += c[0] * Ms[lb] + 2.0 * c[1] * Es[lb];
+                val[pos] = v;
+            }
+        }
+    }
+}
+
 /* Fills the solver's values with cM M + cE 2 M_eps + cK K + cD K0 on free dofs. */
 static void fill_system(object *o, double cM, double cE, double cK, double cD)
 {
     double *val = sem_linear_solver_values(o->solver);
-    /* every block entry has its own position (or none): the group pairs are independent */
+    const double c[4] = {cM, cE, cK, cD};
 #pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
-    for (int g = 0; g < o->n_gpairs; ++g) {
-        if (o->gpair_a[g] > o->gpair_b[g]) continue; /* mapped nowhere (see setup_system) */
-        size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
-        size_t off = o->gpair_offset[g];
-        for (size_t la = 0; la < na; ++la) {
-            const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
-            for (int dd = 0; dd < 9; ++dd) {
-                int diag = dd / 3 == dd % 3;
-                size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
-                const int *map = o->map + row;
-                const double *K = o->K_blocks + row, *K0 = o->K0_blocks + row;
-                for (size_t lb = 0; lb < nb; ++lb) {
-                    int pos = map[lb];
-                    if (pos < 0) continue;
-                    double v = cK * K[lb] + cD * K0[lb];
-                    if (diag) v += cM * Ms[lb] + 2.0 * cE * Es[lb];
-                    val[pos] = v;
-                }
-            }
-        }
-    }
+    for (int g = 0; g < o->n_gpairs; ++g) fill_gpair(o, g, c, val);
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -1542,7 +1616,9 @@ static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
+    /* the system matrix's values are written as its K blocks are formed */
+    const double coef[4] = {1.0 + h * a, h * h * o->gamma, h * h, h * b};
+    if ((st = assemble_elastic(o, o->q, 1, g, o->n_free > 0 ? coef : NULL, err)) != SEM_OK) goto done;
     external_force(o, w->time, f);
     /* f_total = f_ext - grad V - 2 gamma M_eps q */
     error_term(o, o->q, tmp);
@@ -1564,7 +1640,6 @@ static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err
         for (size_t i = 0; i < n; ++i) rhs[i] -= tmp[i];
     }
     if (o->n_free > 0) {
-        fill_system(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b);
         if ((st = sem_linear_solver_factorize(o->solver, err)) != SEM_OK) goto done;
         w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
         gather_free(o, rhs, fr);
@@ -1620,7 +1695,7 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
 #define ENERGY(qq, out)                                                                    \
     do {                                                                                   \
         sem_error e_;                                                                      \
-        if (assemble_elastic(o, (qq), 0, NULL, &e_) != SEM_OK) {                          \
+        if (assemble_elastic(o, (qq), 0, NULL, NULL, &e_) != SEM_OK) {                          \
             (out) = INFINITY;                                                              \
         } else {                                                                           \
             double E_ = o->elastic_energy + error_term(o, (qq), tmp);                      \
@@ -1642,7 +1717,7 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
     double g0norm = -1;
     int it;
     for (it = 0; it < w->def.newton_max_iterations; ++it) {
-        if ((st = assemble_elastic(o, o->q, 1, g, err)) != SEM_OK) goto done;
+        if ((st = assemble_elastic(o, o->q, 1, g, NULL, err)) != SEM_OK) goto done;
         /* gradient: grad V + 2 gamma M_eps q - f + M (q - q_pred)/h^2 + damping */
         error_term(o, o->q, tmp);
         for (size_t i = 0; i < n; ++i) g[i] += tmp[i] - f[i];
@@ -1839,7 +1914,7 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
     for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
     s->error_energy = error_term(o, o->q, tmp);
     sem_error e;
-    if (assemble_elastic(o, o->q, 0, NULL, &e) == SEM_OK)
+    if (assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK)
         s->elastic_energy = o->elastic_energy;
     else
         s->elastic_energy = INFINITY;
