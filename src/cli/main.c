@@ -201,21 +201,32 @@ static void print_command_help(const cli_command *c)
 /* OpenMP threads that spin-wait after a parallel region take the second core from
  * OpenBLAS's threads in the factorization that follows, and OpenBLAS's spinning threads
  * take it back from the next parallel region: on 2 cores that made a 650-dof step (4 ms
- * of factorization) take 14-20 ms instead of 7-11 (sem bench, rockets). The OpenMP
- * runtime reads its wait policy once, from the environment, before main runs; so unless
- * the user chose one, sem restarts itself once with OMP_WAIT_POLICY=passive (sleeping
- * threads); SEM_NO_RESTART=1 turns that off, and it is skipped under valgrind. Programs
- * using libsem directly can set the variable themselves. */
-static void prefer_passive_openmp(char **argv)
+ * of factorization) take 14-20 ms instead of 7-11 (sem bench, rockets). OpenBLAS's idle
+ * threads spin (sched_yield) for 2^28 cycles, 0.13 s, before they sleep, i.e. through
+ * every step's assembly: on the 1800-dof mug the step took 46-52 ms instead of 40-42
+ * (sem bench, OPENBLAS_THREAD_TIMEOUT 28 against 18-22). Both runtimes read these settings
+ * once, from the environment, before main runs; so sem restarts itself once with
+ * OMP_WAIT_POLICY=passive (sleeping OpenMP threads) and OPENBLAS_THREAD_TIMEOUT=20 (2^20
+ * cycles, about 0.5 ms: OpenBLAS's threads stay awake through a factorization's BLAS
+ * calls and sleep during assembly), each unless the user set it. SEM_NO_RESTART=1 turns
+ * the restart off, and it is skipped under valgrind. Programs using libsem directly can
+ * set the variables themselves. */
+static void prefer_passive_threads(char **argv)
 {
 #if defined(__linux__)
-    if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT") || getenv("SEM_NO_RESTART")) return;
+    if (getenv("SEM_NO_RESTART")) return;
+    int set_omp = !getenv("OMP_WAIT_POLICY") && !getenv("GOMP_SPINCOUNT");
+    int set_blas = !getenv("OPENBLAS_THREAD_TIMEOUT") && !getenv("GOTO_THREAD_TIMEOUT");
+    if (!set_omp && !set_blas) return;
     /* under valgrind the restarted process would run outside it */
     const char *preload = getenv("LD_PRELOAD");
     if (preload && strstr(preload, "vgpreload")) return;
-    if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+    if (set_omp && setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+    if (set_blas && setenv("OPENBLAS_THREAD_TIMEOUT", "20", 1) != 0) return;
     execv("/proc/self/exe", argv);
-    unsetenv("OMP_WAIT_POLICY"); /* exec failed: carry on as we are */
+    /* exec failed: carry on as we are */
+    if (set_omp) unsetenv("OMP_WAIT_POLICY");
+    if (set_blas) unsetenv("OPENBLAS_THREAD_TIMEOUT");
 #else
     (void)argv;
 #endif
@@ -223,7 +234,7 @@ static void prefer_passive_openmp(char **argv)
 
 int main(int argc, char **argv)
 {
-    prefer_passive_openmp(argv);
+    prefer_passive_threads(argv);
     if (argc < 2) {
         print_help(stderr);
         return CLI_USAGE;
