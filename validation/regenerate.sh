@@ -6,6 +6,9 @@
 # tools/fem/cantilever.py for that (needs gmsh and CalculiX, installed on demand).
 set -e
 B=${1:-build}
+# the thread settings the sem command gives itself (see src/cli/main.c), for the study programs
+export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-passive}"
+export OPENBLAS_THREAD_TIMEOUT="${OPENBLAS_THREAD_TIMEOUT:-20}"
 V=validation
 FEM="--fem $V/fem_cantilever.json"
 "$B"/study_deflection $FEM --gamma 1e7 > $V/deflection_g1e7.dat
