@@ -42,6 +42,7 @@
 #include <string.h>
 
 #include "linear_solver.h"
+#include "simulation_internal.h"
 
 typedef struct object {
     sem_object_def def;
@@ -477,6 +478,14 @@ static sem_status setup_points(object *o, sem_error *err)
     return SEM_OK;
 }
 
+#define DEFAULT_ASSEMBLY_CHUNK 8192
+static int assembly_chunk = DEFAULT_ASSEMBLY_CHUNK;
+
+void sem_simulation_set_assembly_chunk(int points)
+{
+    assembly_chunk = points > 0 ? points : DEFAULT_ASSEMBLY_CHUNK;
+}
+
 /* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
  * part's own basis, b(X - Xbar_i) with s = ref_X - Xbar_i, to the shared one, b(X - ref_X). */
 static void basis_shift(int m, const double s[3], double *T)
@@ -570,7 +579,7 @@ static sem_status setup_stiffness(object *o, sem_error *err)
     int n3 = 3 * ma;
     o->n_packed = n3 * (n3 + 1) / 2;
     /* points are assembled in chunks so that N stays small (27 MB at most) */
-    o->chunk = o->n_quad < 8192 ? (o->n_quad > 0 ? o->n_quad : 1) : 8192;
+    o->chunk = o->n_quad < assembly_chunk ? (o->n_quad > 0 ? o->n_quad : 1) : assembly_chunk;
     o->N_chunk = malloc(((size_t)o->chunk * o->n_packed + 1) * sizeof(double));
     o->Kz = malloc(((size_t)o->n_pairs * n3 * n3 + 1) * sizeof(double));
     o->Kz_packed = o->chunk < o->n_quad
