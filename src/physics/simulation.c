@@ -1396,7 +1396,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
             if (!U || o->gpair_a[g] > o->gpair_b[g]) continue;
             int na = (int)gsize(o, o->gpair_a[g]), nb = (int)gsize(o, o->gpair_b[g]);
             double *blk = o->K_blocks + 9 * o->gpair_offset[g];
-            memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
+            int written = 0; /* the first product overwrites the block (no clearing pass) */
             int k = o->gpair_pairs_start[g], end = o->gpair_pairs_start[g + 1];
             while (k < end) {
                 int a = o->pair_a[o->gpair_pairs[k]];
@@ -1411,8 +1411,10 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                 }
                 if (!any) continue;
                 cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, 9 * nb, ma, 1.0, o->pi_shared[a], na,
-                            U, 9 * nb, 1.0, blk, 9 * nb);
+                            U, 9 * nb, written ? 1.0 : 0.0, blk, 9 * nb);
+                written = 1;
             }
+            if (!written) memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
             if (system) fill_gpair(o, g, system, val);
         }
         free(U);
