@@ -24,10 +24,9 @@ static void setup_free(setup *s)
     memset(s, 0, sizeof *s);
 }
 
-/* A 2 x 1 x 1 box (beam_sections 0) or a 1 x 1 x 1 m per section beam, preprocessed with
- * 4 x 4 rays, in a world of its own. */
-static int make_world(setup *s, int beam_sections, int order, const sem_world_def *wd,
-                      const sem_object_def *od_in)
+/* A 2 x 1 x 1 box (beam_sections 0) or a 1 x 1 x 1 m per section beam along x, preprocessed
+ * with 4 x 4 rays, into s->model and s->disc. */
+static int make_model(setup *s, int beam_sections, int order, int points_per_interval)
 {
     memset(s, 0, sizeof *s);
     sem_error err;
@@ -52,11 +51,20 @@ static int make_world(setup *s, int beam_sections, int order, const sem_world_de
     sem_preprocess_options po = sem_default_preprocess_options();
     po.order = order;
     po.rays[0] = po.rays[1] = 4;
-    po.points_per_interval = 4;
+    po.points_per_interval = points_per_interval;
     if (sem_preprocess(s->model, &po, &s->disc, &err) != SEM_OK) {
         CHECK(0, "preprocess: %s", err.message);
         return 0;
     }
+    return 1;
+}
+
+/* make_model (4 points per interval) in a world of its own */
+static int make_world(setup *s, int beam_sections, int order, const sem_world_def *wd,
+                      const sem_object_def *od_in)
+{
+    if (!make_model(s, beam_sections, order, 4)) return 0;
+    sem_error err;
     s->world = sem_world_create(wd, &err);
     CHECK(s->world != NULL, "world: %s", err.message);
     if (!s->world) return 0;
@@ -71,6 +79,18 @@ static int make_world(setup *s, int beam_sections, int order, const sem_world_de
 static int make_box_world(setup *s, int order, const sem_world_def *wd, const sem_object_def *od_in)
 {
     return make_world(s, 0, order, wd, od_in);
+}
+
+/* Rotation of a make_model beam about its axis (y = z = 0.5) at rate rad/s. */
+static sem_prescribe beam_axis_rotation(double rate)
+{
+    sem_prescribe pr;
+    memset(&pr, 0, sizeof pr);
+    pr.type = SEM_PRESCRIBE_ROTATE;
+    pr.axis_point[1] = pr.axis_point[2] = 0.5;
+    pr.axis_direction[0] = 1.0;
+    pr.rate = rate;
+    return pr;
 }
 
 /* Free fall with the linearly implicit Euler step: z_n = z0 - g h^2 n(n+1)/2 exactly,
@@ -229,21 +249,12 @@ static void test_patch(void)
 static void test_twist(void)
 {
     sem_error err;
-    sem_model *m = sem_model_create();
-    sem_beam_def bd = sem_default_beam_def();
-    bd.sections = 4;
-    bd.length = 4.0;
-    CHECK(sem_primitive_beam(m, &bd, &err) == SEM_OK, "%s", err.message);
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.order = 2;
-    po.rays[0] = po.rays[1] = 4;
-    po.points_per_interval = 8;
-    sem_discretization *d = NULL;
-    if (sem_preprocess(m, &po, &d, &err) != SEM_OK) {
-        CHECK(0, "preprocess: %s", err.message);
-        sem_model_destroy(m);
+    setup s;
+    if (!make_model(&s, 4, 2, 8)) {
+        setup_free(&s);
         return;
     }
+    sem_model *m = s.model;
     size_t nc = sem_model_control_points(m);
     double *q0 = malloc(3 * nc * sizeof(double));
     int *group = malloc(nc * sizeof(int));
@@ -253,19 +264,15 @@ static void test_twist(void)
     memset(pr, 0, sizeof pr);
     pr[0].type = SEM_PRESCRIBE_AFFINE; /* identity: fixed */
     pr[0].affine[0] = pr[0].affine[5] = pr[0].affine[10] = 1.0;
-    pr[1].type = SEM_PRESCRIBE_ROTATE;
-    pr[1].axis_point[1] = 0.5 * bd.width;
-    pr[1].axis_point[2] = 0.5 * bd.height;
-    pr[1].axis_direction[0] = 1.0;
-    pr[1].rate = M_PI / 2; /* 90 degrees after 1 s */
+    pr[1] = beam_axis_rotation(M_PI / 2); /* 90 degrees after 1 s */
     sem_world_def wd = sem_default_world_def();
     wd.gravity[2] = 0;
     wd.integrator = SEM_STATIC;
     wd.dt = 1.0;
-    sem_world *w = sem_world_create(&wd, &err);
+    sem_world *w = s.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
     od.model = m;
-    od.disc = d;
+    od.disc = s.disc;
     od.prescribe_group = group;
     od.prescribes = pr;
     od.n_prescribes = 2;
@@ -276,11 +283,12 @@ static void test_twist(void)
     int n_mid = 0;
     for (size_t c = 0; c < nc; ++c) {
         const double *x0 = q0 + 3 * c, *x = q + 3 * c;
-        double y0 = x0[1] - 0.5 * bd.width, z0 = x0[2] - 0.5 * bd.height;
-        double y = x[1] - 0.5 * bd.width, z = x[2] - 0.5 * bd.height;
+        const double *ax = pr[1].axis_point;
+        double y0 = x0[1] - ax[1], z0 = x0[2] - ax[2];
+        double y = x[1] - ax[1], z = x[2] - ax[2];
         if (group[c] == 0) worst_fixed = fmax(worst_fixed, fabs(x[0] - x0[0]) + fabs(x[1] - x0[1]) + fabs(x[2] - x0[2]));
         if (group[c] == 1) worst_rot = fmax(worst_rot, fabs(y - (-z0)) + fabs(z - y0) + fabs(x[0] - x0[0]));
-        if (fabs(x0[0] - 2.0) < 1e-9 && hypot(y0, z0) > 0.3 * bd.width) {
+        if (fabs(x0[0] - 2.0) < 1e-9 && hypot(y0, z0) > 0.3) {
             double a = atan2(z, y) - atan2(z0, y0);
             while (a > M_PI) a -= 2 * M_PI;
             while (a < -M_PI) a += 2 * M_PI;
@@ -297,11 +305,9 @@ static void test_twist(void)
         CHECK(mid_angle > 35 * M_PI / 180 && mid_angle < 55 * M_PI / 180, "middle section turned %g degrees",
               mid_angle * 180 / M_PI);
     }
-    sem_world_destroy(w);
+    setup_free(&s);
     free(group);
     free(q0);
-    sem_discretization_destroy(d);
-    sem_model_destroy(m);
 }
 
 /* Bad world definitions are errors. */
@@ -424,62 +430,46 @@ static void test_assembly_chunks(void)
  * the free rows of (M + h^2 K) v+ = M v are solved by the rigid velocity only if the
  * pinned points' velocities enter the right-hand side through the right stiffness block
  * A_fp (kept for one triangle of group pairs, the other being its transpose). After 0.4 s
- * (0.2 rad) every free control point is within 1.5e-4 beam widths of the rigidly rotated
+ * (0.2 rad) every free control point of the 1 m wide beam is within 1.5e-4 m of the rigidly rotated
  * rest position (3.4e-5 measured; the tangential steps drift off the circle). Without
  * the transposed blocks the worst point is 9e-4 off, without A_fp's stiffness 3.9e-3. */
 static void test_driven_rotation(void)
 {
     sem_error err;
-    sem_model *m = sem_model_create();
-    sem_beam_def bd = sem_default_beam_def();
-    bd.sections = 3;
-    bd.length = 3.0;
-    CHECK(sem_primitive_beam(m, &bd, &err) == SEM_OK, "%s", err.message);
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.rays[0] = po.rays[1] = 4;
-    po.points_per_interval = 6;
-    sem_discretization *d = NULL;
-    if (sem_preprocess(m, &po, &d, &err) != SEM_OK) {
-        CHECK(0, "preprocess: %s", err.message);
-        sem_model_destroy(m);
-        return;
-    }
-    size_t nc = sem_model_control_points(m);
-    double *q0 = malloc(3 * nc * sizeof(double));
-    int *group = malloc(nc * sizeof(int));
-    sem_world *w = NULL;
+    setup s;
+    size_t nc = 0;
+    double *q0 = NULL;
+    int *group = NULL;
+    if (!make_model(&s, 3, 2, 6)) goto done;
+    nc = sem_model_control_points(s.model);
+    q0 = malloc(3 * nc * sizeof(double));
+    group = malloc(nc * sizeof(int));
     if (!q0 || !group) goto done;
-    sem_model_get_q(m, q0);
+    sem_model_get_q(s.model, q0);
     for (size_t c = 0; c < nc; ++c) group[c] = fabs(q0[3 * c]) < 1e-9 ? 0 : -1;
-    sem_prescribe pr;
-    memset(&pr, 0, sizeof pr);
-    pr.type = SEM_PRESCRIBE_ROTATE;
-    pr.axis_point[1] = 0.5 * bd.width;
-    pr.axis_point[2] = 0.5 * bd.height;
-    pr.axis_direction[0] = 1.0;
-    pr.rate = 0.5;
+    sem_prescribe pr = beam_axis_rotation(0.5);
     sem_world_def wd = sem_default_world_def();
     wd.gravity[2] = 0;
     wd.dt = 0.01;
-    w = sem_world_create(&wd, &err);
+    s.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
-    od.model = m;
-    od.disc = d;
+    od.model = s.model;
+    od.disc = s.disc;
     od.prescribe_group = group;
     od.prescribes = &pr;
     od.n_prescribes = 1;
     od.material.youngs_modulus = 1e7;
     od.material.density = 1000;
     od.initial_angular_velocity[0] = pr.rate; /* the whole beam already turns with its cap */
-    int ok = w && sem_world_add_object(w, &od, &err) == 0;
+    int ok = s.world && sem_world_add_object(s.world, &od, &err) == 0;
     CHECK(ok, "%s", err.message);
     for (int k = 0; k < 40 && ok; ++k) {
-        ok = sem_world_step(w, &err) == SEM_OK;
+        ok = sem_world_step(s.world, &err) == SEM_OK;
         CHECK(ok, "step %d: %s", k, err.message);
     }
     if (ok) {
-        const double *q = sem_world_object_q(w, 0);
-        double ang = pr.rate * sem_world_time(w), cs = cos(ang), sn = sin(ang), worst = 0;
+        const double *q = sem_world_object_q(s.world, 0);
+        double ang = pr.rate * sem_world_time(s.world), cs = cos(ang), sn = sin(ang), worst = 0;
         for (size_t c = 0; c < nc; ++c) {
             if (group[c] == 0) continue;
             const double *x0 = q0 + 3 * c, *x = q + 3 * c;
@@ -489,12 +479,10 @@ static void test_driven_rotation(void)
                                      (x[2] - rz) * (x[2] - rz)));
         }
         printf("driven rotation: worst free point %.3e m from the rigid rotation (%.3f rad)\n", worst, ang);
-        CHECK(worst < 1.5e-4 * bd.width, "free points are up to %g m off the rigid rotation", worst);
+        CHECK(worst < 1.5e-4, "free points are up to %g m off the rigid rotation (beam width 1 m)", worst);
     }
 done:
-    sem_world_destroy(w);
-    sem_discretization_destroy(d);
-    sem_model_destroy(m);
+    setup_free(&s);
     free(q0);
     free(group);
 }
