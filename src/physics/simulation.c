@@ -70,7 +70,8 @@ typedef struct object {
     double ref_X[3];           /* the shared basis is b(X - ref_X) */
     double **pi_shared;        /* per part: ma x |group|, rows 1..m-1 of T_i^T Pi_i */
     double *point_D;           /* per point: ma x 3, d b_k(X_p - ref_X) / dX_e, k = 1..m-1 */
-    int *plist_start;          /* per part pair (upper ones): its points, in order */
+    int *plist_start;          /* per part pair: its points, in order; only pairs a <= b that
+                                * share a quadrature point have any (see pair_has_points) */
     int *plist_point;
     double *plist_w;           /* w_a w_b at that point */
     int *plist_cursor;         /* per pair: first entry not yet summed (chunked assembly) */
@@ -109,9 +110,7 @@ typedef struct object {
     /* z-space work */
     double *z;                 /* n_parts*ma x 3: shared-basis coefficients */
     double *grad_z;            /* n_parts*ma x 3 */
-    double *Kz;                /* n_pairs x (3ma)^2, upper pairs only (Kz_ab = Kz_ba) */
-    unsigned char *pair_upper; /* per part pair: a <= b and the pair shares a quadrature point
-                                * (the blocks the point loop writes) */
+    double *Kz;                /* n_pairs x (3ma)^2, for pairs with points (Kz_ba = Kz_ab) */
     int nthreads;
     double *grad_z_thread;
     double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
@@ -187,7 +186,6 @@ static void object_destroy(object *o)
     free(o->entry_basis);
     free(o->entry_pair_offset);
     free(o->part_mats);
-    free(o->pair_upper);
     free(o->point_pairs);
     free(o->pair_a);
     free(o->pair_b);
@@ -452,8 +450,7 @@ static sem_status setup_points(object *o, sem_error *err)
         o->entry_pair_offset[p + 1] = (int)n_pp;
     }
     o->point_pairs = malloc((n_pp + 1) * sizeof(int));
-    o->pair_upper = calloc((size_t)o->n_pairs + 1, 1);
-    if (!o->point_pairs || !o->pair_upper) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    if (!o->point_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
 #pragma omp parallel for schedule(static)
     for (int p = 0; p < o->n_quad; ++p) {
         const double *X = d->quad_X + 3 * (size_t)p;
@@ -471,10 +468,6 @@ static sem_status setup_points(object *o, sem_error *err)
                 o->point_pairs[pp++] = o->pair_lookup[(size_t)i * o->n_parts + W->col[r2]];
         }
     }
-    for (int p = 0; p < o->n_quad; ++p)
-        for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
-            for (int r2 = r; r2 < W->row_start[p + 1]; ++r2)
-                o->pair_upper[o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]]] = 1;
     return SEM_OK;
 }
 
@@ -484,6 +477,13 @@ static int assembly_chunk = DEFAULT_ASSEMBLY_CHUNK;
 void sem_simulation_set_assembly_chunk(int points)
 {
     assembly_chunk = points > 0 ? points : DEFAULT_ASSEMBLY_CHUNK;
+}
+
+/* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
+ * (W rows list parts in increasing order). */
+static int pair_has_points(const object *o, int pr)
+{
+    return o->plist_start[pr + 1] > o->plist_start[pr];
 }
 
 /* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
@@ -578,7 +578,7 @@ static sem_status setup_stiffness(object *o, sem_error *err)
             }
     int n3 = 3 * ma;
     o->n_packed = n3 * (n3 + 1) / 2;
-    /* points are assembled in chunks so that N stays small (27 MB at most) */
+    /* points are assembled in chunks so that N stays small (25 MB at most) */
     o->chunk = o->n_quad < assembly_chunk ? (o->n_quad > 0 ? o->n_quad : 1) : assembly_chunk;
     o->N_chunk = malloc(((size_t)o->chunk * o->n_packed + 1) * sizeof(double));
     o->Kz = malloc(((size_t)o->n_pairs * n3 * n3 + 1) * sizeof(double));
@@ -1308,7 +1308,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
             int first = c0 == 0, last = c1 == o->n_quad;
 #pragma omp for schedule(dynamic, 8)
             for (int pr = 0; pr < o->n_pairs; ++pr) {
-                if (!o->pair_upper[pr]) continue;
+                if (!pair_has_points(o, pr)) continue;
                 double acc[378];
                 if (first) {
                     memset(acc, 0, (size_t)np * sizeof(double));
@@ -1404,7 +1404,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                 for (; k < end && o->pair_a[o->gpair_pairs[k]] == a; ++k) {
                     int pr = o->gpair_pairs[k], b = o->pair_b[pr];
                     int up = a <= b ? pr : o->pair_lookup[(size_t)b * o->n_parts + a];
-                    if (!o->pair_upper[up]) continue;
+                    if (!pair_has_points(o, up)) continue;
                     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, 3 * n3, nb, ma, 1.0,
                                 o->Kz + (size_t)up * bs, ma, o->pi_shared[b], nb, any ? 1.0 : 0.0, U, nb);
                     any = 1;
