@@ -19,7 +19,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "bench/validation.h"
 #include "sem/preprocess.h"
@@ -39,8 +38,7 @@ int main(int argc, char **argv)
     }
     if (repeat < 1) repeat = 1;
     const char *dir = dir_arg ? dir_arg : sem_bench_models_dir();
-    struct stat st;
-    if (!dir || stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+    if (!sem_bench_is_dir(dir)) {
         fprintf(stderr, "bench_preprocess: models folder %s not found\n", dir ? dir : "../shared/models");
         return 1;
     }

@@ -13,18 +13,18 @@
 
 #include "sem/simulation.h"
 
-static int is_dir(const char *p)
+int sem_bench_is_dir(const char *path)
 {
     struct stat st;
-    return p && stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+    return path && stat(path, &st) == 0 && S_ISDIR(st.st_mode);
 }
 
 const char *sem_bench_models_dir(void)
 {
     const char *env = getenv("SEM_SHARED_MODELS");
-    if (is_dir(env)) return env;
-    if (is_dir("../shared/models")) return "../shared/models";
-    if (is_dir("../../shared/models")) return "../../shared/models";
+    if (sem_bench_is_dir(env)) return env;
+    if (sem_bench_is_dir("../shared/models")) return "../shared/models";
+    if (sem_bench_is_dir("../../shared/models")) return "../../shared/models";
     return NULL;
 }
 

@@ -52,6 +52,9 @@ sem_status sem_fem_reference_read(const char *path, double *tip_deflection, sem_
  * *c (may be NULL). NaN with fewer than 2 usable points. */
 double sem_loglog_fit(const double *x, const double *y, int n, double *c);
 
+/* 1 when path (may be NULL) names a folder. */
+int sem_bench_is_dir(const char *path);
+
 /* The shared models folder: $SEM_SHARED_MODELS, else ../shared/models, else
  * ../../shared/models (the first that is a folder); NULL when none is. */
 const char *sem_bench_models_dir(void);

@@ -40,12 +40,6 @@ typedef struct bench_result {
     const char *solver;
 } bench_result;
 
-static int is_dir(const char *p)
-{
-    struct stat st;
-    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
 static sem_status run_row(const sem_table1_row *r, const char *path, int steps, int repeat,
                           bench_result *out, sem_error *err)
 {
@@ -153,7 +147,7 @@ int cmd_bench(int argc, char **argv)
     }
     if (!dir) dir = sem_bench_models_dir();
     if (!dir) return cli_fail("no models folder: pass --models DIR or set SEM_SHARED_MODELS");
-    if (!is_dir(dir)) return cli_fail("%s: not a folder", dir);
+    if (!sem_bench_is_dir(dir)) return cli_fail("%s: not a folder", dir);
 
     cJSON *list = json ? cJSON_CreateArray() : NULL;
     if (json && !list) return cli_fail("out of memory");
