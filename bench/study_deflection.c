@@ -5,7 +5,8 @@
  * interval) as a percentage of the converged FEM figure, versus parts and degrees of freedom.
  *
  * usage: study_deflection [--models DIR] [--fem FILE] [--sections LIST] [--gamma G]
- *                         [--material NAME] [--no-files] [--no-generated]
+ *                         [--alpha A] [--material NAME] [--rays N1 N2]
+ *                         [--points-per-interval N] [--no-files] [--no-generated]
  *   --models DIR    folder of the shared models (beams/perf/b1..b10.igs); default
  *                   $SEM_SHARED_MODELS, ../shared/models or ../../shared/models
  *   --fem FILE      FEM reference (default validation/fem_cantilever.json, also tried
@@ -13,6 +14,7 @@
  *   --sections LIST comma-separated section counts of generated beams (sem_primitive_beam),
  *                   default 1,2,3,4,5,6,8,10,12,15,20,25,30
  *   --gamma G       error stiffness (default: the preprocessing default, kappa E / L)
+ *   --alpha A       weight cut-off distance in metres (default the authors' 0.501)
  *   --material NAME neohookean (default) or any name sem_material_parse_type accepts
  *   --rays N1 N2    ray grid across x (default the authors' 3 x 3)
  *   --points-per-interval N (default 100)
@@ -61,6 +63,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--fem") && i + 1 < argc) fem_path = argv[++i];
         else if (!strcmp(argv[i], "--sections") && i + 1 < argc) sections_arg = argv[++i];
         else if (!strcmp(argv[i], "--gamma") && i + 1 < argc) s.gamma = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--alpha") && i + 1 < argc) s.alpha = atof(argv[++i]);
         else if (!strcmp(argv[i], "--rays") && i + 2 < argc) {
             s.rays[0] = atoi(argv[++i]);
             s.rays[1] = atoi(argv[++i]);
@@ -74,7 +77,7 @@ int main(int argc, char **argv)
         } else if (!strcmp(argv[i], "--no-files")) files = 0;
         else if (!strcmp(argv[i], "--no-generated")) generated = 0;
         else {
-            fprintf(stderr, "usage: %s [--models DIR] [--fem FILE] [--sections LIST] [--gamma G] "
+            fprintf(stderr, "usage: %s [--models DIR] [--fem FILE] [--sections LIST] [--gamma G] [--alpha A] "
                             "[--material NAME] [--rays N1 N2] [--points-per-interval N] [--no-files] "
                             "[--no-generated]\n", argv[0]);
             return 2;
