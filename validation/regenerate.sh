@@ -18,6 +18,8 @@ FEM="--fem $V/fem_cantilever.json"
 "$B"/study_deflection $FEM --no-generated --material stable_neohookean > $V/deflection_default_snh.dat
 "$B"/study_deflection $FEM --no-generated --gamma 1e7 --material stable_neohookean > $V/deflection_snh.dat
 "$B"/study_deflection $FEM --no-generated --gamma 1e7 --material linear > $V/deflection_linear.dat
+"$B"/study_weight_gradient > $V/deflection_gradw.dat
+"$B"/study_weight_gradient --delta 0.15 > $V/deflection_gradw_d015.dat
 "$B"/study_scaling > $V/scaling.dat
 "$B"/study_volume > $V/volume.dat
 "$B"/sem bench --json > $V/bench.json
