@@ -1776,25 +1776,20 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
         double scale = fmax(g0norm, fscale);
         if (o->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) break;
         fill_system(o, cM, o->gamma, 1.0, cD);
-        if (o->exact_hessian) {
-            sem_error ignored;
-            st = sem_linear_solver_factorize(o->solver, &ignored);
-            w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
-            if (st == SEM_ERR_NUMERIC) { /* not positive definite: project after all */
-                o->exact_hessian = 0;
-                exact_hessian_fallbacks++;
-                exact_allowed = 0; /* e.g. a buckled or unstable equilibrium: stay projected */
-                if ((st = assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
-                fill_system(o, cM, o->gamma, 1.0, cD);
-            } else if (st != SEM_OK) {
-                st = sem_error_set(err, st, "%s", ignored.message);
-                goto done;
-            }
-        }
-        if (!o->exact_hessian) {
-            if ((st = sem_linear_solver_factorize(o->solver, err)) != SEM_OK) goto done;
+        st = sem_linear_solver_factorize(o->solver, err);
+        w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        if (st == SEM_ERR_NUMERIC && o->exact_hessian) {
+            /* the exact system is not positive definite (e.g. a buckled or unstable
+             * equilibrium): project, for the rest of this solve */
+            o->exact_hessian = 0;
+            exact_allowed = 0;
+            exact_hessian_fallbacks++;
+            if ((st = assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
+            fill_system(o, cM, o->gamma, 1.0, cD);
+            st = sem_linear_solver_factorize(o->solver, err);
             w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
         }
+        if (st != SEM_OK) goto done;
         if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
         memset(dq, 0, n * sizeof(double));
         scatter_free(o, fr, dq);
