@@ -83,14 +83,15 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    double fem = 0;
+    int counts[64];
+    int n_counts = sem_parse_count_list(sections_arg, 1000, counts, 64);
+    if (n_counts < 0) {
+        fprintf(stderr, "study_deflection: bad --sections list %s (up to 64 counts, 1..1000)\n",
+                sections_arg);
+        return 2;
+    }
     sem_error err;
-    const char *candidates[] = {fem_path, "validation/fem_cantilever.json",
-                                "../validation/fem_cantilever.json"};
-    for (int k = 0; k < 3 && fem <= 0; ++k)
-        if (candidates[k] && exists(candidates[k]) &&
-            sem_fem_reference_read(candidates[k], &fem, &err) != SEM_OK)
-            fprintf(stderr, "study_deflection: %s\n", err.message);
+    double fem = sem_fem_reference_find(fem_path, "study_deflection");
     if (fem <= 0) fprintf(stderr, "study_deflection: no FEM reference; percent column is nan\n");
 
     printf("# SEM static cantilever vs FEM (tip deflection %.6f m)\n", fem);
@@ -124,15 +125,8 @@ int main(int argc, char **argv)
         }
     }
     if (generated) {
-        const char *p = sections_arg;
-        while (*p) {
-            char *end;
-            long n = strtol(p, &end, 10);
-            if (end == p || n < 1 || n > 1000) {
-                fprintf(stderr, "study_deflection: bad --sections list %s\n", sections_arg);
-                return 2;
-            }
-            p = *end == ',' ? end + 1 : end;
+        for (int j = 0; j < n_counts; ++j) {
+            long n = counts[j];
             sem_model *m = sem_model_create();
             sem_beam_def bd = sem_default_beam_def();
             bd.sections = (int)n;

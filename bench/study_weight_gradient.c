@@ -8,21 +8,22 @@
  * over +-delta along each axis, for every part whose weight is non-zero at any of the 7 points.
  * This is a research program, not the simulator: it forms the gradient operator densely
  * (3 points x control points), assembles the dense Hessian and solves the static cantilever
- * (generated beams, clamped at x = 0, gravity 10 m/s^2 along -z, rho 1000, neo-Hookean E 1e6,
- * nu 0.45, the authors' settings: quadratic, alpha 0.501, rays 3 x 3, 100 points per
- * interval) with Newton and a backtracking line search, like sem_world_solve_static (PSD
+ * of study_deflection (generated beams, sem_default_cantilever_settings: clamped at x = 0,
+ * gravity 10 m/s^2 along -z, rho 1000, neo-Hookean E 1e6, nu 0.45, the authors' settings:
+ * quadratic, alpha 0.501, rays 3 x 3, 100 points per interval; the same clamp and tip
+ * measure, sem_cantilever_clamp and sem_cantilever_tip) with Newton and a backtracking line search, like sem_world_solve_static (PSD
  * projected Hessian, exact once two steps in a row were full). The error energy uses the
  * preprocessing's M_eps. With --delta 0 it solves Eq. 15 itself, a check against
- * study_deflection (within 0.05 % of its tips: the simulator's error matrix floors each sample's
- * area at 5 % of its part's mean).
+ * study_deflection (10 sections: 3.973578 m from both).
  *
  * usage: study_weight_gradient [--sections LIST] [--delta D] [--gamma G] [--rays N]
- *                              [--fem TIP_M]
+ *                              [--fem FILE]
  *   --sections LIST  section counts (default 1,2,4,6,8,10,12,15,20,25,30)
  *   --delta D        difference step for grad w in metres (default 0.1; 0: Eq. 15)
  *   --gamma G        error stiffness (default: the preprocessing default, 1000 E / L)
  *   --rays N         N x N rays across x (default 3)
- *   --fem TIP_M      FEM tip deflection for the percentage (default 4.238047, the recorded one)
+ *   --fem FILE       FEM reference (default validation/fem_cantilever.json, also tried
+ *                    relative to ..)
  * Output: sections dofs delta gamma tip_m percent_of_fem newton, one line per beam.
  */
 #include <cblas.h>
@@ -32,6 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench/validation.h"
 #include "preprocess/raycast.h"
 #include "preprocess/steps.h"
 #include "sem/material.h"
@@ -44,6 +46,7 @@ typedef struct problem {
     int n, N;          /* control points, quadrature points */
     double *G;         /* 3N x n: F_p[c][e] = sum_j G[3p+e][j] Q[j][c] */
     double *Q0, *f;    /* rest control points, gravity force (3n each) */
+    unsigned char *pin; /* clamped control points (sem_cantilever_clamp) */
     double gamma;
     sem_material mat;
     int exact;         /* 1: unprojected per-point Hessians */
@@ -182,15 +185,14 @@ static int add_weight_gradient(problem *pb, const sem_model *m, double delta, se
     return ok;
 }
 
-/* Newton on the free dofs (x > x_min); returns iterations, -1 on failure. */
+/* Newton on the free dofs (the unclamped control points); returns iterations, -1 on
+ * failure. */
 static int solve(problem *pb, double *Q)
 {
     const int n = pb->n;
     int *fidx = malloc(sizeof(int) * 3 * (size_t)n), nf = 0, it = -1;
-    double xmin = INFINITY;
-    for (int j = 0; j < n; ++j) xmin = fmin(xmin, pb->Q0[3 * j]);
     for (int j = 0; fidx && j < n; ++j)
-        if (pb->Q0[3 * j] > xmin + 1e-9)
+        if (!pb->pin[j])
             for (int c = 0; c < 3; ++c) fidx[nf++] = 3 * j + c;
     double *g = malloc(sizeof(double) * 3 * n), *K = malloc(sizeof(double) * 9 * (size_t)n * n);
     double *Kf = malloc(sizeof(double) * (size_t)nf * nf + 1), *r = malloc(sizeof(double) * nf + 1);
@@ -256,7 +258,7 @@ done:
     return it;
 }
 
-static int run(int sections, double delta, double gamma, int rays, double fem)
+static int run(int sections, double delta, const sem_cantilever_settings *s, double fem)
 {
     sem_error err;
     int status = 1;
@@ -268,26 +270,20 @@ static int run(int sections, double delta, double gamma, int rays, double fem)
     sem_beam_def bd = sem_default_beam_def();
     bd.sections = sections;
     if (!m || sem_primitive_beam(m, &bd, &err) != SEM_OK) goto fail;
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.order = 2;
-    po.rays[0] = po.rays[1] = rays;
-    po.points_per_interval = 100;
-    po.alpha = 0.501;
-    po.youngs_modulus = 1e6;
-    po.gamma = gamma;
+    sem_preprocess_options po = sem_cantilever_preprocess_options(s);
     if (sem_preprocess(m, &po, &d, &err) != SEM_OK) goto fail;
     pb.d = d;
     pb.n = d->n_ctrl;
     pb.N = d->n_quad;
     pb.gamma = d->gamma;
-    pb.mat = sem_default_material();
-    if (sem_material_init(&pb.mat, &err) != SEM_OK) goto fail;
+    if (sem_cantilever_material(s, &pb.mat, &err) != SEM_OK) goto fail;
     const int n = pb.n;
     pb.G = calloc(3 * (size_t)pb.N * n, sizeof(double));
     pb.Q0 = malloc(sizeof(double) * 3 * n);
     pb.f = calloc(3 * (size_t)n, sizeof(double));
+    pb.pin = malloc((size_t)n);
     Q = malloc(sizeof(double) * 3 * n);
-    if (!pb.G || !pb.Q0 || !pb.f || !Q) {
+    if (!pb.G || !pb.Q0 || !pb.f || !pb.pin || !Q) {
         sem_error_set(&err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -296,25 +292,19 @@ static int run(int sections, double delta, double gamma, int rays, double fem)
             pb.G[(size_t)r * n + d->Grad.col[k]] += d->Grad.val[k];
     if (delta > 0 && !add_weight_gradient(&pb, m, delta, &err)) goto fail;
     sem_model_get_q(m, pb.Q0);
+    sem_cantilever_clamp(pb.Q0, (size_t)n, pb.pin);
     for (int p = 0; p < pb.N; ++p)
         for (int k = d->Gamma.row_start[p]; k < d->Gamma.row_start[p + 1]; ++k)
-            pb.f[3 * d->Gamma.col[k] + 2] -= 1000.0 * 10.0 * d->quad_volume[p] * d->Gamma.val[k];
+            pb.f[3 * d->Gamma.col[k] + 2] -=
+                pb.mat.density * s->gravity * d->quad_volume[p] * d->Gamma.val[k];
     int it = solve(&pb, Q);
     if (it < 0) {
         sem_error_set(&err, SEM_ERR_NUMERIC, "Newton failed");
         goto fail;
     }
-    double xmax = -INFINITY, tip = 0;
-    int nt = 0;
-    for (int j = 0; j < n; ++j) xmax = fmax(xmax, pb.Q0[3 * j]);
-    for (int j = 0; j < n; ++j)
-        if (pb.Q0[3 * j] > xmax - 1e-9) {
-            tip -= Q[3 * j + 2] - pb.Q0[3 * j + 2];
-            nt++;
-        }
-    tip /= nt;
+    double tip = sem_cantilever_tip(m, pb.Q0, Q);
     printf("%3d %5d %6g %10.4g %9.6f %8.3f %4d\n", sections, 3 * n, delta, pb.gamma, tip,
-           100 * tip / fem, it);
+           fem > 0 ? 100 * tip / fem : NAN, it);
     fflush(stdout);
     status = 0;
     goto done;
@@ -324,6 +314,7 @@ done:
     free(pb.G);
     free(pb.Q0);
     free(pb.f);
+    free(pb.pin);
     free(Q);
     sem_discretization_destroy(d);
     if (m) sem_model_destroy(m);
@@ -333,40 +324,37 @@ done:
 int main(int argc, char **argv)
 {
     const char *sections = "1,2,4,6,8,10,12,15,20,25,30";
-    double delta = 0.1, gamma = 0, fem = 4.238047;
-    int rays = 3;
+    const char *fem_path = NULL;
+    double delta = 0.1;
+    sem_cantilever_settings st = sem_default_cantilever_settings();
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sections") && i + 1 < argc) sections = argv[++i];
         else if (!strcmp(argv[i], "--delta") && i + 1 < argc) delta = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--gamma") && i + 1 < argc) gamma = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--rays") && i + 1 < argc) rays = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--fem") && i + 1 < argc) fem = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--gamma") && i + 1 < argc) st.gamma = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--rays") && i + 1 < argc) st.rays[0] = st.rays[1] = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--fem") && i + 1 < argc) fem_path = argv[++i];
         else {
             fprintf(stderr, "usage: %s [--sections LIST] [--delta D] [--gamma G] [--rays N] "
-                            "[--fem TIP_M]\n", argv[0]);
+                            "[--fem FILE]\n", argv[0]);
             return 2;
         }
     }
-    if (!(delta >= 0) || rays < 1 || !(gamma >= 0) || !(fem > 0)) {
-        fprintf(stderr, "study_weight_gradient: need delta >= 0, gamma >= 0, rays >= 1, fem > 0\n");
+    if (!(delta >= 0) || st.rays[0] < 1 || !(st.gamma >= 0)) {
+        fprintf(stderr, "study_weight_gradient: need delta >= 0, gamma >= 0, rays >= 1\n");
         return 2;
     }
+    int counts[64];
+    int n_counts = sem_parse_count_list(sections, 1000, counts, 64);
+    if (n_counts < 0) {
+        fprintf(stderr, "study_weight_gradient: bad --sections list %s (up to 64 counts, 1..1000)\n",
+                sections);
+        return 2;
+    }
+    double fem = sem_fem_reference_find(fem_path, "study_weight_gradient");
+    if (fem <= 0) fprintf(stderr, "study_weight_gradient: no FEM reference; percent column is nan\n");
     printf("# static cantilever with F = sum w_i grad P_i + P_i (x) grad w_i (delta 0: Eq. 15)\n");
     printf("# sections dofs delta gamma tip_m percent_of_fem newton\n");
     int failures = 0;
-    for (const char *s = sections; *s;) {
-        char *end;
-        long k = strtol(s, &end, 10);
-        if (end == s || k < 1 || k > 1000) {
-            fprintf(stderr, "study_weight_gradient: bad section list %s\n", sections);
-            return 2;
-        }
-        failures += run((int)k, delta, gamma, rays, fem);
-        s = *end == ',' ? end + 1 : end;
-        if (*end && *end != ',') {
-            fprintf(stderr, "study_weight_gradient: bad section list %s\n", sections);
-            return 2;
-        }
-    }
+    for (int j = 0; j < n_counts; ++j) failures += run(counts[j], delta, &st, fem);
     return failures ? 1 : 0;
 }

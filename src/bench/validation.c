@@ -45,8 +45,58 @@ sem_cantilever_settings sem_default_cantilever_settings(void)
     return s;
 }
 
-/* Mean -u_z over the control points of the parts lying entirely at the largest x. */
-static double tip_deflection(const sem_model *m, const double *q0, const double *q)
+sem_preprocess_options sem_cantilever_preprocess_options(const sem_cantilever_settings *s)
+{
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.order = s->order;
+    po.rays[0] = s->rays[0];
+    po.rays[1] = s->rays[1];
+    po.points_per_interval = s->points_per_interval;
+    po.alpha = s->alpha;
+    po.youngs_modulus = s->youngs_modulus;
+    po.threads = s->threads;
+    if (s->gamma > 0) po.gamma = s->gamma;
+    return po;
+}
+
+sem_status sem_cantilever_material(const sem_cantilever_settings *s, sem_material *m,
+                                   sem_error *err)
+{
+    sem_material t = sem_default_material();
+    t.type = s->material;
+    t.density = s->density;
+    t.youngs_modulus = s->youngs_modulus;
+    t.poisson_ratio = s->poisson_ratio;
+    sem_status st = sem_material_init(&t, err);
+    if (st == SEM_OK) *m = t;
+    return st;
+}
+
+void sem_cantilever_clamp(const double *q0, size_t nc, unsigned char *pin)
+{
+    double xmin = INFINITY, xmax = -INFINITY;
+    for (size_t c = 0; c < nc; ++c) {
+        xmin = fmin(xmin, q0[3 * c]);
+        xmax = fmax(xmax, q0[3 * c]);
+    }
+    for (size_t c = 0; c < nc; ++c) pin[c] = q0[3 * c] < xmin + 1e-9 * fmax(1.0, xmax - xmin);
+}
+
+int sem_parse_count_list(const char *text, int max, int *out, int cap)
+{
+    int n = 0;
+    const char *p = text;
+    while (*p) {
+        char *end;
+        long v = strtol(p, &end, 10);
+        if (end == p || v < 1 || v > max || n == cap || (*end && *end != ',')) return -1;
+        out[n++] = (int)v;
+        p = *end ? end + 1 : end;
+    }
+    return n;
+}
+
+double sem_cantilever_tip(const sem_model *m, const double *q0, const double *q)
 {
     size_t nc = sem_model_control_points(m);
     double xmax = -INFINITY, xmin = INFINITY;
@@ -82,15 +132,7 @@ static double tip_deflection(const sem_model *m, const double *q0, const double 
 sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_settings *s,
                                 sem_cantilever_result *out, sem_error *err)
 {
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.order = s->order;
-    po.rays[0] = s->rays[0];
-    po.rays[1] = s->rays[1];
-    po.points_per_interval = s->points_per_interval;
-    po.alpha = s->alpha;
-    po.youngs_modulus = s->youngs_modulus;
-    po.threads = s->threads;
-    if (s->gamma > 0) po.gamma = s->gamma;
+    sem_preprocess_options po = sem_cantilever_preprocess_options(s);
     double t0 = omp_get_wtime();
     sem_discretization *d = NULL;
     sem_status st = sem_preprocess(model, &po, &d, err);
@@ -106,12 +148,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
         goto done;
     }
     sem_model_get_q(model, q0);
-    double xmin = INFINITY, xmax = -INFINITY;
-    for (size_t c = 0; c < nc; ++c) {
-        xmin = fmin(xmin, q0[3 * c]);
-        xmax = fmax(xmax, q0[3 * c]);
-    }
-    for (size_t c = 0; c < nc; ++c) pin[c] = q0[3 * c] < xmin + 1e-9 * fmax(1.0, xmax - xmin);
+    sem_cantilever_clamp(q0, nc, pin);
 
     sem_world_def wd = sem_default_world_def();
     wd.gravity[2] = -s->gravity;
@@ -125,10 +162,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     sem_object_def od = sem_default_object_def();
     od.model = model;
     od.disc = d;
-    od.material.type = s->material;
-    od.material.density = s->density;
-    od.material.youngs_modulus = s->youngs_modulus;
-    od.material.poisson_ratio = s->poisson_ratio;
+    if ((st = sem_cantilever_material(s, &od.material, err)) != SEM_OK) goto done;
     od.gamma = s->gamma;
     od.pinned = pin;
     if (sem_world_add_object(w, &od, err) < 0) {
@@ -142,7 +176,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     out->dofs = sem_world_object_dofs(w, 0);
     out->quad_points = d->n_quad;
     out->volume = d->volume;
-    out->tip_deflection = tip_deflection(model, q0, sem_world_object_q(w, 0));
+    out->tip_deflection = sem_cantilever_tip(model, q0, sem_world_object_q(w, 0));
     out->newton_iterations = sem_world_last_iterations(w);
     out->preprocess_s = t1 - t0;
     out->solve_s = t2 - t1;
@@ -152,6 +186,21 @@ done:
     free(q0);
     sem_discretization_destroy(d);
     return st;
+}
+
+double sem_fem_reference_find(const char *path, const char *who)
+{
+    const char *candidates[] = {path, "validation/fem_cantilever.json",
+                                "../validation/fem_cantilever.json"};
+    double fem = 0;
+    struct stat st;
+    for (int k = 0; k < 3 && fem <= 0; ++k) {
+        sem_error err;
+        if (candidates[k] && stat(candidates[k], &st) == 0 &&
+            sem_fem_reference_read(candidates[k], &fem, &err) != SEM_OK)
+            fprintf(stderr, "%s: %s\n", who, err.message);
+    }
+    return fem;
 }
 
 sem_status sem_fem_reference_read(const char *path, double *tip_deflection, sem_error *err)

@@ -38,6 +38,23 @@ typedef struct sem_cantilever_result {
     double preprocess_s, solve_s;
 } sem_cantilever_result;
 
+/* The preprocessing options of the settings (order, rays, points per interval, alpha, E,
+ * gamma when > 0, threads). */
+sem_preprocess_options sem_cantilever_preprocess_options(const sem_cantilever_settings *s);
+/* The material of the settings (type, density, E, nu; Lame parameters set). */
+sem_status sem_cantilever_material(const sem_cantilever_settings *s, sem_material *m,
+                                   sem_error *err);
+/* The clamp: pin[c] = 1 for the control points at the smallest x of the rest positions q0
+ * (3 per point, nc points), 0 for the others. */
+void sem_cantilever_clamp(const double *q0, size_t nc, unsigned char *pin);
+/* Tip deflection: mean -u_z over the control points of the parts lying entirely at the
+ * largest x (every control point at that x when no part does); NaN if none. */
+double sem_cantilever_tip(const sem_model *m, const double *q0, const double *q);
+
+/* Positive integers separated by commas ("1,2,10"), each <= max, into out (at most cap);
+ * returns how many, or -1 for a malformed or too long list. */
+int sem_parse_count_list(const char *text, int max, int *out, int cap);
+
 /* Preprocesses the model with the settings and solves statics. The free end is the part
  * whose control points all lie at the largest x (the end cap; for a uniform biquadratic
  * Bezier cap the mean of its control points is exactly its area-weighted mean, since each
@@ -47,6 +64,10 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
 
 /* Reads "tip_deflection_m" of the FEM reference file written by tools/fem/cantilever.py. */
 sem_status sem_fem_reference_read(const char *path, double *tip_deflection, sem_error *err);
+/* The FEM tip deflection from the first readable of path (may be NULL),
+ * validation/fem_cantilever.json and ../validation/fem_cantilever.json; files that do not
+ * exist are skipped, each unreadable one is reported on stderr after `who`. 0 if none. */
+double sem_fem_reference_find(const char *path, const char *who);
 
 /* Least squares y = c x^p on log-log axes over the points with x, y > 0: returns p, sets
  * *c (may be NULL). NaN with fewer than 2 usable points. */
