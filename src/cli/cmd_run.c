@@ -39,45 +39,6 @@ static void cache_dir(char *out, size_t size)
     snprintf(out, size, "%s/.cache/sem", h && *h ? h : "/tmp");
 }
 
-static void mkdirs(const char *path)
-{
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; ++p)
-        if (*p == '/') {
-            *p = '\0';
-            mkdir(tmp, 0777);
-            *p = '/';
-        }
-    mkdir(tmp, 0777);
-}
-
-/* Preprocesses or loads from the cache. *cached tells which. */
-static sem_status preprocess_cached(const sem_model *model, const sem_preprocess_options *opt, int use_cache,
-                                    sem_discretization **out, int *cached, sem_error *err)
-{
-    *cached = 0;
-    unsigned long long hash = sem_preprocess_hash(model, opt);
-    char dir[4096], path[4200];
-    cache_dir(dir, sizeof dir);
-    snprintf(path, sizeof path, "%s/%016llx.semdisc", dir, hash);
-    if (use_cache) {
-        sem_error e;
-        if (sem_discretization_load(path, hash, out, &e) == SEM_OK) {
-            *cached = 1;
-            return SEM_OK;
-        }
-    }
-    sem_status st = sem_preprocess(model, opt, out, err);
-    if (st != SEM_OK) return st;
-    if (use_cache) {
-        mkdirs(dir);
-        sem_error e;
-        if (sem_discretization_save(*out, path, &e) != SEM_OK) cli_warn("cannot write the cache: %s", e.message);
-    }
-    return SEM_OK;
-}
-
 static cJSON *vec3(const double v[3])
 {
     return cJSON_CreateDoubleArray(v, 3);
@@ -85,21 +46,13 @@ static cJSON *vec3(const double v[3])
 
 typedef struct run_state {
     sem_scene *scene;
+    sem_scene_world *sw;
     int n;
-    sem_model **models;
-    sem_discretization **discs;
-    unsigned char **pins;
-    int **part_mat;
-    int **presc_group;
-    sem_prescribe **prescs;
-    sem_material **mats;
     sem_world *world;
     sem_animation *anim;
     cJSON *frames;
     int steps;
     double step_sum, step_max, factor_sum;
-    int cached_all;
-    double preprocess_s;
 } run_state;
 
 static void add_frame_stats(run_state *r, double t)
@@ -150,8 +103,8 @@ static cJSON *summary(run_state *r, const char *status, const char *error)
         cJSON_AddNumberToObject(o, "volume", st.volume);
         cJSON_AddNumberToObject(o, "mass", st.mass);
         cJSON_AddNumberToObject(o, "dofs", sem_world_object_dofs(r->world, i));
-        cJSON_AddNumberToObject(o, "parts", r->models[i]->n_parts);
-        cJSON_AddNumberToObject(o, "quadrature_points", r->discs[i]->n_quad);
+        cJSON_AddNumberToObject(o, "parts", sem_scene_world_model(r->sw, i)->n_parts);
+        cJSON_AddNumberToObject(o, "quadrature_points", sem_scene_world_discretization(r->sw, i)->n_quad);
         cJSON_AddStringToObject(o, "solver", sem_world_solver_name(r->world, i));
         cJSON_AddNumberToObject(o, "nnz_percent", sem_world_object_nnz_percent(r->world, i));
         cJSON_AddItemToArray(objs, o);
@@ -166,8 +119,8 @@ static cJSON *summary(run_state *r, const char *status, const char *error)
     cJSON_AddNumberToObject(s, "mean_step_s", r->steps ? r->step_sum / r->steps : 0.0);
     cJSON_AddNumberToObject(s, "max_step_s", r->step_max);
     cJSON_AddNumberToObject(s, "mean_factor_s", r->steps ? r->factor_sum / r->steps : 0.0);
-    cJSON_AddNumberToObject(s, "preprocess_s", r->preprocess_s);
-    cJSON_AddBoolToObject(s, "preprocess_cached", r->cached_all);
+    cJSON_AddNumberToObject(s, "preprocess_s", sem_scene_world_preprocess_seconds(r->sw));
+    cJSON_AddBoolToObject(s, "preprocess_cached", sem_scene_world_all_cached(r->sw));
     cJSON_AddStringToObject(s, "output_dir", r->scene->output_dir);
     if (r->anim && r->scene->write_usd) cJSON_AddStringToObject(s, "usd", sem_animation_usd_path(r->anim));
     cJSON_AddItemToObject(s, "objects", objs);
@@ -202,25 +155,19 @@ static int write_summary(run_state *r, const char *status, const char *error, in
 static void run_free(run_state *r)
 {
     sem_animation_destroy(r->anim);
-    sem_world_destroy(r->world);
-    for (int i = 0; i < r->n; ++i) {
-        if (r->discs) sem_discretization_destroy(r->discs[i]);
-        if (r->models) sem_model_destroy(r->models[i]);
-        if (r->pins) free(r->pins[i]);
-        if (r->part_mat) free(r->part_mat[i]);
-        if (r->presc_group) free(r->presc_group[i]);
-        if (r->prescs) free(r->prescs[i]);
-        if (r->mats) free(r->mats[i]);
-    }
-    free(r->models);
-    free(r->discs);
-    free(r->pins);
-    free(r->part_mat);
-    free(r->presc_group);
-    free(r->prescs);
-    free(r->mats);
+    sem_scene_world_destroy(r->sw);
     cJSON_Delete(r->frames);
     sem_scene_destroy(r->scene);
+}
+
+/* Log lines of the scene world: information unless --quiet, warnings always. */
+static void run_log(void *user, int level, const char *message)
+{
+    const int *quiet = user;
+    if (level > 0)
+        cli_warn("%s", message);
+    else if (!*quiet)
+        fprintf(stderr, "sem: %s\n", message);
 }
 
 int cmd_run(int argc, char **argv)
@@ -261,83 +208,32 @@ int cmd_run(int argc, char **argv)
     if (frames >= 0) r.scene->frames = frames;
     if (out_dir) snprintf(r.scene->output_dir, sizeof r.scene->output_dir, "%s", out_dir);
     if (!scene_path && !quiet) fprintf(stderr, "sem: no scene given; running the embedded default scene (%s)\n", "rubber beam clamped at x = 0");
-    r.n = r.scene->n_objects;
-    r.models = calloc((size_t)r.n, sizeof *r.models);
-    r.discs = calloc((size_t)r.n, sizeof *r.discs);
-    r.pins = calloc((size_t)r.n, sizeof *r.pins);
-    r.part_mat = calloc((size_t)r.n, sizeof *r.part_mat);
-    r.presc_group = calloc((size_t)r.n, sizeof *r.presc_group);
-    r.prescs = calloc((size_t)r.n, sizeof *r.prescs);
-    r.mats = calloc((size_t)r.n, sizeof *r.mats);
     r.frames = cJSON_CreateArray();
     int rc = CLI_FAILED;
-    if (!r.models || !r.discs || !r.pins || !r.part_mat || !r.mats || !r.presc_group || !r.prescs || !r.frames) {
+    if (!r.frames) {
         cli_fail("out of memory");
         goto done;
     }
-    r.world = sem_world_create(&r.scene->world, &err);
-    if (!r.world) {
-        cli_fail_error(r.scene->path, &err);
+    char cache[4096];
+    cache_dir(cache, sizeof cache);
+    sem_scene_world_options wo = sem_default_scene_world_options();
+    wo.cache_dir = cache;
+    wo.read_cache = use_cache;
+    wo.write_cache = use_cache;
+    wo.log = run_log;
+    wo.log_user = &quiet;
+    if (sem_scene_world_create(r.scene, &wo, &r.sw, &err) != SEM_OK) {
+        cli_fail_error(NULL, &err);
         goto done;
     }
-    r.cached_all = 1;
-    double t_pre = omp_get_wtime();
-    for (int i = 0; i < r.n; ++i) {
-        if ((st = sem_scene_object_model(r.scene, i, &r.models[i], &err)) != SEM_OK) {
-            cli_fail_error(NULL, &err);
-            goto done;
-        }
-        cli_print_model_warnings(r.models[i]);
-        if (!quiet) fprintf(stderr, "sem: object %d: %d parts, %zu dofs; preprocessing...\n", i, r.models[i]->n_parts, 3 * sem_model_control_points(r.models[i]));
-        int cached = 0;
-        if ((st = preprocess_cached(r.models[i], &r.scene->objects[i].sem, use_cache, &r.discs[i], &cached, &err)) != SEM_OK) {
-            cli_fail("%s: objects[%d]: %s", r.scene->path[0] ? r.scene->path : "default scene", i, err.message);
-            goto done;
-        }
-        r.cached_all &= cached;
-        if (!quiet)
-            fprintf(stderr, "sem: object %d: %s: %d quadrature points, volume %.6g\n", i,
-                    cached ? "preprocessed data reused from the cache" : "preprocessed", r.discs[i]->n_quad,
-                    r.discs[i]->volume);
-        const sem_scene_object *so = &r.scene->objects[i];
-        if ((st = sem_scene_object_pins(so, r.models[i], &r.pins[i], &err)) != SEM_OK ||
-            (st = sem_scene_object_part_materials(so, r.models[i], &r.part_mat[i], &r.mats[i], &err)) != SEM_OK ||
-            (st = sem_scene_object_prescribe_groups(so, r.models[i], &r.presc_group[i], &err)) != SEM_OK) {
-            cli_fail("%s: objects[%d].%s", r.scene->path[0] ? r.scene->path : "default scene", i, err.message);
-            goto done;
-        }
-        sem_object_def od = sem_default_object_def();
-        od.model = r.models[i];
-        od.disc = r.discs[i];
-        od.material = so->material;
-        od.part_material = r.part_mat[i];
-        od.part_materials = r.mats[i];
-        od.n_part_materials = so->n_part_materials;
-        od.pinned = r.pins[i];
-        od.prescribe = so->prescribe;
-        if (r.presc_group[i]) {
-            r.prescs[i] = malloc((size_t)so->n_prescribe_groups * sizeof(sem_prescribe));
-            if (!r.prescs[i]) {
-                cli_fail("out of memory");
-                goto done;
-            }
-            for (int g = 0; g < so->n_prescribe_groups; ++g) r.prescs[i][g] = so->prescribe_groups[g].prescribe;
-            od.prescribe_group = r.presc_group[i];
-            od.prescribes = r.prescs[i];
-            od.n_prescribes = so->n_prescribe_groups;
-        }
-        memcpy(od.initial_velocity, so->initial_velocity, sizeof od.initial_velocity);
-        memcpy(od.initial_angular_velocity, so->initial_angular_velocity, sizeof od.initial_angular_velocity);
-        od.point_loads = so->point_loads;
-        od.n_point_loads = so->n_point_loads;
-        od.region_loads = so->region_loads;
-        od.n_region_loads = so->n_region_loads;
-        if (sem_world_add_object(r.world, &od, &err) < 0) {
-            cli_fail("%s: objects[%d]: %s", r.scene->path[0] ? r.scene->path : "default scene", i, err.message);
-            goto done;
-        }
+    r.n = sem_scene_world_object_count(r.sw);
+    r.world = sem_scene_world_world(r.sw);
+    const sem_model **models = malloc((size_t)r.n * sizeof *models);
+    if (!models) {
+        cli_fail("out of memory");
+        goto done;
     }
-    r.preprocess_s = omp_get_wtime() - t_pre;
+    for (int i = 0; i < r.n; ++i) models[i] = sem_scene_world_model(r.sw, i);
     sem_animation_def ad;
     memset(&ad, 0, sizeof ad);
     ad.dir = r.scene->output_dir;
@@ -347,7 +243,9 @@ int cmd_run(int argc, char **argv)
     ad.write_usd = r.scene->write_usd;
     ad.mesh_resolution = r.scene->mesh_resolution;
     ad.frames_per_second = 1.0 / (r.scene->world.dt * r.scene->steps_per_frame);
-    if (sem_animation_create(&ad, r.n, (const sem_model *const *)r.models, &r.anim, &err) != SEM_OK) {
+    st = sem_animation_create(&ad, r.n, models, &r.anim, &err);
+    free(models);
+    if (st != SEM_OK) {
         cli_fail_error(NULL, &err);
         goto done;
     }

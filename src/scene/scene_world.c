@@ -1,0 +1,260 @@
+/*
+ * scene_world.c - a scene turned into a world (see sem/scene.h).
+ *
+ * For every object of a scene: load or generate its model and apply its transform,
+ * preprocess it (or reuse a discretization cached under its hash, sem_preprocess_hash),
+ * resolve its pins, part materials and prescribed groups against the model, and add it to
+ * a world made from the scene's world settings. Everything the world points into (models,
+ * discretizations, pin flags, material tables) is owned here and lives as long as the
+ * world, so any program - the command line, a viewer, a binding - runs a scene the same way.
+ *
+ * The cache folder is a setting (the command line picks it from the environment); nothing
+ * here reads the environment or prints: information and warnings go to the log callback.
+ */
+#include <omp.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "sem/scene.h"
+
+struct sem_scene_world {
+    const sem_scene *scene;
+    int n;
+    sem_model **models;
+    sem_discretization **discs;
+    unsigned char **pins;
+    int **part_material;
+    int **prescribe_group;
+    sem_prescribe **prescribes;
+    sem_material **materials;
+    sem_world *world;
+    int all_cached;
+    double preprocess_s;
+};
+
+sem_scene_world_options sem_default_scene_world_options(void)
+{
+    sem_scene_world_options o;
+    memset(&o, 0, sizeof o);
+    return o;
+}
+
+static void logf_(const sem_scene_world_options *o, int level, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void logf_(const sem_scene_world_options *o, int level, const char *fmt, ...)
+{
+    if (!o->log) return;
+    char msg[1200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    o->log(o->log_user, level, msg);
+}
+
+static void make_dirs(const char *path)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s", path);
+    for (char *p = tmp + 1; *p; ++p)
+        if (*p == '/') {
+            *p = '\0';
+            mkdir(tmp, 0777);
+            *p = '/';
+        }
+    mkdir(tmp, 0777);
+}
+
+/* Prefixes err's message with "NAME: objects[I]SEP" (copied first: the message is both the
+ * source and the destination). */
+static sem_status prefix_error(sem_error *err, sem_status st, const char *name, int i,
+                               const char *sep)
+{
+    if (!err) return st;
+    char msg[sizeof err->message];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    return sem_error_set(err, st, "%s: objects[%d]%s%s", name, i, sep, msg);
+}
+
+/* Preprocesses, or loads from the cache; *cached tells which. */
+static sem_status preprocess_cached(const sem_model *model, const sem_preprocess_options *opt,
+                                    const sem_scene_world_options *o, sem_discretization **out,
+                                    int *cached, sem_error *err)
+{
+    *cached = 0;
+    int have_dir = o->cache_dir && o->cache_dir[0];
+    unsigned long long hash = sem_preprocess_hash(model, opt);
+    char path[4200] = "";
+    if (have_dir) snprintf(path, sizeof path, "%s/%016llx.semdisc", o->cache_dir, hash);
+    if (have_dir && o->read_cache) {
+        sem_error e;
+        if (sem_discretization_load(path, hash, out, &e) == SEM_OK) {
+            *cached = 1;
+            return SEM_OK;
+        }
+    }
+    sem_status st = sem_preprocess(model, opt, out, err);
+    if (st != SEM_OK) return st;
+    if (have_dir && o->write_cache) {
+        make_dirs(o->cache_dir);
+        sem_error e;
+        if (sem_discretization_save(*out, path, &e) != SEM_OK)
+            logf_(o, 1, "cannot write the cache: %s", e.message);
+    }
+    return SEM_OK;
+}
+
+void sem_scene_world_destroy(sem_scene_world *sw)
+{
+    if (!sw) return;
+    sem_world_destroy(sw->world);
+    for (int i = 0; i < sw->n; ++i) {
+        if (sw->discs) sem_discretization_destroy(sw->discs[i]);
+        if (sw->models) sem_model_destroy(sw->models[i]);
+        if (sw->pins) free(sw->pins[i]);
+        if (sw->part_material) free(sw->part_material[i]);
+        if (sw->prescribe_group) free(sw->prescribe_group[i]);
+        if (sw->prescribes) free(sw->prescribes[i]);
+        if (sw->materials) free(sw->materials[i]);
+    }
+    free(sw->models);
+    free(sw->discs);
+    free(sw->pins);
+    free(sw->part_material);
+    free(sw->prescribe_group);
+    free(sw->prescribes);
+    free(sw->materials);
+    free(sw);
+}
+
+/* Builds object i and adds it to the world. */
+static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
+                               sem_error *err)
+{
+    const sem_scene *scene = sw->scene;
+    const char *name = scene->path[0] ? scene->path : "default scene";
+    const sem_scene_object *so = &scene->objects[i];
+    sem_status st = sem_scene_object_model(scene, i, &sw->models[i], err);
+    if (st != SEM_OK) return st;
+    const sem_model *model = sw->models[i];
+    for (int k = 0; k < model->n_warnings; ++k)
+        if (model->warnings[k]) logf_(o, 1, "%s", model->warnings[k]);
+    logf_(o, 0, "object %d: %d parts, %zu dofs; preprocessing...", i, model->n_parts,
+          3 * sem_model_control_points(model));
+    int cached = 0;
+    st = preprocess_cached(model, &so->sem, o, &sw->discs[i], &cached, err);
+    if (st != SEM_OK) return prefix_error(err, st, name, i, ": ");
+    sw->all_cached &= cached;
+    logf_(o, 0, "object %d: %s: %d quadrature points, volume %.6g", i,
+          cached ? "preprocessed data reused from the cache" : "preprocessed", sw->discs[i]->n_quad,
+          sw->discs[i]->volume);
+
+    if ((st = sem_scene_object_pins(so, model, &sw->pins[i], err)) != SEM_OK ||
+        (st = sem_scene_object_part_materials(so, model, &sw->part_material[i], &sw->materials[i],
+                                              err)) != SEM_OK ||
+        (st = sem_scene_object_prescribe_groups(so, model, &sw->prescribe_group[i], err)) != SEM_OK)
+        return prefix_error(err, st, name, i, ".");
+
+    sem_object_def od = sem_default_object_def();
+    od.model = model;
+    od.disc = sw->discs[i];
+    od.material = so->material;
+    od.part_material = sw->part_material[i];
+    od.part_materials = sw->materials[i];
+    od.n_part_materials = so->n_part_materials;
+    od.pinned = sw->pins[i];
+    od.prescribe = so->prescribe;
+    if (sw->prescribe_group[i]) {
+        sw->prescribes[i] = malloc((size_t)so->n_prescribe_groups * sizeof(sem_prescribe));
+        if (!sw->prescribes[i]) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int g = 0; g < so->n_prescribe_groups; ++g)
+            sw->prescribes[i][g] = so->prescribe_groups[g].prescribe;
+        od.prescribe_group = sw->prescribe_group[i];
+        od.prescribes = sw->prescribes[i];
+        od.n_prescribes = so->n_prescribe_groups;
+    }
+    memcpy(od.initial_velocity, so->initial_velocity, sizeof od.initial_velocity);
+    memcpy(od.initial_angular_velocity, so->initial_angular_velocity,
+           sizeof od.initial_angular_velocity);
+    od.point_loads = so->point_loads;
+    od.n_point_loads = so->n_point_loads;
+    od.region_loads = so->region_loads;
+    od.n_region_loads = so->n_region_loads;
+    if (sem_world_add_object(sw->world, &od, err) < 0)
+        return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
+    return SEM_OK;
+}
+
+sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_options *options,
+                                  sem_scene_world **out, sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!scene || !out)
+        return sem_error_set(err, SEM_ERR_INVALID, "sem_scene_world_create: NULL argument");
+    sem_scene_world_options o = options ? *options : sem_default_scene_world_options();
+    sem_scene_world *sw = calloc(1, sizeof *sw);
+    if (!sw) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sw->scene = scene;
+    sw->n = scene->n_objects;
+    size_t n = (size_t)(sw->n > 0 ? sw->n : 1);
+    sw->models = calloc(n, sizeof *sw->models);
+    sw->discs = calloc(n, sizeof *sw->discs);
+    sw->pins = calloc(n, sizeof *sw->pins);
+    sw->part_material = calloc(n, sizeof *sw->part_material);
+    sw->prescribe_group = calloc(n, sizeof *sw->prescribe_group);
+    sw->prescribes = calloc(n, sizeof *sw->prescribes);
+    sw->materials = calloc(n, sizeof *sw->materials);
+    sem_status st = SEM_OK;
+    if (!sw->models || !sw->discs || !sw->pins || !sw->part_material || !sw->prescribe_group ||
+        !sw->prescribes || !sw->materials) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    sw->world = sem_world_create(&scene->world, err);
+    if (!sw->world) {
+        st = err ? err->status : SEM_ERR_INVALID;
+        if (err && scene->path[0] && !strstr(err->message, scene->path)) {
+            char msg[sizeof err->message];
+            snprintf(msg, sizeof msg, "%s", err->message);
+            sem_error_set(err, st, "%s: %s", scene->path, msg);
+        }
+        goto fail;
+    }
+    sw->all_cached = 1;
+    double t0 = omp_get_wtime();
+    for (int i = 0; i < sw->n; ++i)
+        if ((st = build_object(sw, i, &o, err)) != SEM_OK) goto fail;
+    sw->preprocess_s = omp_get_wtime() - t0;
+    *out = sw;
+    return SEM_OK;
+fail:
+    sem_scene_world_destroy(sw);
+    return st;
+}
+
+sem_world *sem_scene_world_world(sem_scene_world *sw) { return sw ? sw->world : NULL; }
+
+const sem_scene *sem_scene_world_scene(const sem_scene_world *sw) { return sw ? sw->scene : NULL; }
+
+int sem_scene_world_object_count(const sem_scene_world *sw) { return sw ? sw->n : 0; }
+
+const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object)
+{
+    return sw && object >= 0 && object < sw->n ? sw->models[object] : NULL;
+}
+
+const sem_discretization *sem_scene_world_discretization(const sem_scene_world *sw, int object)
+{
+    return sw && object >= 0 && object < sw->n ? sw->discs[object] : NULL;
+}
+
+int sem_scene_world_all_cached(const sem_scene_world *sw) { return sw ? sw->all_cached : 0; }
+
+double sem_scene_world_preprocess_seconds(const sem_scene_world *sw)
+{
+    return sw ? sw->preprocess_s : 0.0;
+}
