@@ -28,16 +28,32 @@
 extern "C" {
 #endif
 
+/* How each part is given its deformation origin among the candidate groups of Sec. 6.2 (both
+ * solve the network of Eq. 10 with GLPK; see src/preprocess/origins.c). */
+typedef enum sem_origin_rule {
+    SEM_ORIGINS_DOMINANT = 0, /* default: the group where the part's weight sum is largest, tied
+                                 groups merged (symmetric models stay symmetric) */
+    SEM_ORIGINS_PAPER = 1     /* the paper's cost: the group where it is smallest */
+} sem_origin_rule;
+
 typedef struct sem_preprocess_options {
     int order;               /* 1 (linear) or 2 (quadratic, default) */
-    int rays[2];             /* ray grid (n1, n2) across the ray axis; default 40 x 40 */
-    int ray_axis;            /* 0 = x (default), 1 = y, 2 = z */
-    int points_per_interval; /* volume points per inside interval; default 2 */
+    /* Volume quadrature (Sec. 6.3). Default: a ray grid laid in the object's own frame (the
+     * principal axes of its surface), cells of `spacing` across the rays and points spaced
+     * alike along them, so the quadrature turns with the object. `rays` gives the paper's
+     * explicit grid instead: n1 x n2 rays along the world axis `ray_axis`. */
+    double spacing;          /* cell size of the object-frame grid, model units; 0 (default):
+                                automatic, from the object's size and thinnest extent */
+    int rays[2];             /* explicit grid (n1, n2) across ray_axis; 0 x 0 (default): none */
+    int ray_axis;            /* with rays: 0 = x, 1 = y, 2 = z; -1 (default): x */
+    int points_per_interval; /* points per inside interval; 0 (default): as many as the
+                                interval's length holds at the grid's spacing */
     double alpha;            /* weight cut-off distance, model units; <= 0: use sparsity */
     double sparsity;         /* target non-zero fraction T in (0,1) when alpha <= 0;
                                 when both are unset (alpha 0, sparsity 0): alpha = half
                                 the median part size (its samples' bbox diagonal) */
     double weight_threshold; /* weights below are dropped; default 1e-4 */
+    int origin_rule;         /* sem_origin_rule; default SEM_ORIGINS_DOMINANT */
     double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
     double youngs_modulus;   /* for the default gamma; default 1e6 */
     int tessellation;        /* triangle grid cells per knot span per direction; default 16 */
@@ -70,7 +86,14 @@ typedef struct sem_discretization {
     double *sample_area;   /* area weight (diagonal of S) */
     sem_csr J_hat;         /* n_samples x n_ctrl: x(sample) = J_hat Q */
 
+    /* the object's frame (object_frame.c): rows of frame_axes are unit axes by decreasing
+     * extent, frame_lo/hi the tessellation's bounds along them relative to frame_center */
+    double frame_axes[9];
+    double frame_center[3];
+    double frame_lo[3], frame_hi[3];
+
     /* volume quadrature (Sec. 6.3) */
+    double quad_spacing;   /* cell size across the rays of the grid used (geometric mean) */
     int n_quad;
     double *quad_X;        /* 3 per point */
     double *quad_volume;   /* per point */

@@ -481,11 +481,14 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
     /* default gamma = kappa E / L (Sec. 7.6; see the file comment) */
     {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int s = 0; s < d->n_samples; ++s)
+        for (int s = 0; s < d->n_samples; ++s) {
+            double Y[3]; /* in the object's frame: L does not change when it is turned */
+            sem_frame_coordinates(d, d->sample_X + 3 * (size_t)s, Y);
             for (int e = 0; e < 3; ++e) {
-                lo[e] = fmin(lo[e], d->sample_X[3 * (size_t)s + e]);
-                hi[e] = fmax(hi[e], d->sample_X[3 * (size_t)s + e]);
+                lo[e] = fmin(lo[e], Y[e]);
+                hi[e] = fmax(hi[e], Y[e]);
             }
+        }
         double L2 = 0;
         if (d->n_samples > 0)
             for (int e = 0; e < 3; ++e) L2 += (hi[e] - lo[e]) * (hi[e] - lo[e]);

@@ -42,7 +42,7 @@
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
 
-#define SEM_DISC_FORMAT_VERSION 2u
+#define SEM_DISC_FORMAT_VERSION 3u
 #define SEM_DISC_BYTE_ORDER 0x01020304u
 static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
 
@@ -54,13 +54,15 @@ sem_preprocess_options sem_default_preprocess_options(void)
     sem_preprocess_options o;
     memset(&o, 0, sizeof o);
     o.order = 2;
-    o.rays[0] = 40;
-    o.rays[1] = 40;
-    o.ray_axis = 0;
-    o.points_per_interval = 2;
+    o.spacing = 0.0;  /* automatic object-frame grid (quadrature step) */
+    o.rays[0] = 0;
+    o.rays[1] = 0;
+    o.ray_axis = -1;
+    o.points_per_interval = 0;
     o.alpha = 0.0;    /* with sparsity 0: alpha = 0.5 x bbox diagonal (weights step) */
     o.sparsity = 0.0;
     o.weight_threshold = 1e-4;
+    o.origin_rule = SEM_ORIGINS_DOMINANT;
     o.gamma = 0.0;    /* default kappa E / L (operators step) */
     o.youngs_modulus = 1e6;
     o.tessellation = 16;
@@ -77,16 +79,30 @@ static sem_status validate_options(const sem_preprocess_options *o, sem_error *e
 {
     if (o->order != 1 && o->order != 2)
         return sem_error_set(err, SEM_ERR_INVALID, "order must be 1 or 2 (got %d)", o->order);
-    for (int k = 0; k < 2; ++k)
-        if (o->rays[k] < 1 || o->rays[k] > MAX_RAYS_PER_AXIS)
-            return sem_error_set(err, SEM_ERR_INVALID, "rays must be between 1 and %d (got %d x %d)",
-                                 MAX_RAYS_PER_AXIS, o->rays[0], o->rays[1]);
-    if (o->ray_axis < 0 || o->ray_axis > 2)
+    int explicit_grid = o->rays[0] != 0 || o->rays[1] != 0;
+    if (explicit_grid)
+        for (int k = 0; k < 2; ++k)
+            if (o->rays[k] < 1 || o->rays[k] > MAX_RAYS_PER_AXIS)
+                return sem_error_set(err, SEM_ERR_INVALID,
+                                     "rays must be between 1 and %d (got %d x %d)",
+                                     MAX_RAYS_PER_AXIS, o->rays[0], o->rays[1]);
+    if (o->ray_axis < -1 || o->ray_axis > 2)
         return sem_error_set(err, SEM_ERR_INVALID, "ray axis must be 0 (x), 1 (y) or 2 (z) (got %d)",
                              o->ray_axis);
-    if (o->points_per_interval < 1 || o->points_per_interval > MAX_POINTS_PER_INTERVAL)
+    if (o->ray_axis >= 0 && !explicit_grid)
         return sem_error_set(err, SEM_ERR_INVALID,
-                             "points per interval must be between 1 and %d (got %d)",
+                             "a ray axis needs an explicit rays grid (without rays the grid is "
+                             "laid in the object's own frame)");
+    if (!isfinite(o->spacing) || o->spacing < 0)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "spacing must be > 0 (or 0 for the automatic one) (got %g)", o->spacing);
+    if (o->spacing > 0 && explicit_grid)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "give a quadrature spacing or a rays grid, not both");
+    if (o->points_per_interval < 0 || o->points_per_interval > MAX_POINTS_PER_INTERVAL)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "points per interval must be between 1 and %d, or 0 for as many as "
+                             "the spacing holds (got %d)",
                              MAX_POINTS_PER_INTERVAL, o->points_per_interval);
     if (!isfinite(o->alpha) || o->alpha < 0)
         return sem_error_set(err, SEM_ERR_INVALID,
@@ -98,6 +114,9 @@ static sem_status validate_options(const sem_preprocess_options *o, sem_error *e
     if (!isfinite(o->weight_threshold) || o->weight_threshold < 0 || o->weight_threshold >= 1)
         return sem_error_set(err, SEM_ERR_INVALID, "weight threshold must be in [0,1) (got %g)",
                              o->weight_threshold);
+    if (o->origin_rule != SEM_ORIGINS_DOMINANT && o->origin_rule != SEM_ORIGINS_PAPER)
+        return sem_error_set(err, SEM_ERR_INVALID, "origin rule must be 0 (dominant) or 1 (paper) (got %d)",
+                             o->origin_rule);
     if (!isfinite(o->gamma) || o->gamma < 0)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "gamma must be > 0 (or 0 for the default E / L) (got %g)", o->gamma);
@@ -247,10 +266,11 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
         fnv_int(&f, o->rays[1]);
         fnv_int(&f, o->ray_axis);
         fnv_int(&f, o->points_per_interval);
-        const double v[5] = {o->alpha, o->sparsity, o->weight_threshold, o->gamma,
-                             o->youngs_modulus};
-        fnv_doubles(&f, v, 5);
+        const double v[6] = {o->alpha, o->sparsity, o->weight_threshold, o->gamma,
+                             o->youngs_modulus, o->spacing};
+        fnv_doubles(&f, v, 6);
         fnv_int(&f, o->tessellation);
+        fnv_int(&f, o->origin_rule);
     }
     return (unsigned long long)f.h;
 }
@@ -378,14 +398,15 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     if (st != SEM_OK) goto done;
     double t1b = omp_get_wtime();
     d->timings.scene_s = t1b - t1;
-    st = sem_step_quadrature(model, scene, &o, d, err);
+    st = sem_step_frame(scene, d, err);
+    if (st == SEM_OK) st = sem_step_quadrature(model, scene, &o, d, err);
     if (st != SEM_OK) goto done;
     double t2 = omp_get_wtime();
     d->timings.quad_s = t2 - t1b;
     if (d->n_quad <= 0 || !(d->volume > 0)) {
         st = sem_error_set(err, SEM_ERR_INVALID,
-                           "model encloses no volume (no ray of the %d x %d grid found an inside)",
-                           o.rays[0], o.rays[1]);
+                           "model encloses no volume (no ray of the quadrature grid found an "
+                           "inside)");
         goto done;
     }
 
@@ -394,7 +415,7 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     int n_covered = 0;
     st = sem_cover_unweighted_parts(d, &n_covered, err);
     if (st != SEM_OK) goto done;
-    st = sem_step_origins(model, d, err);
+    st = sem_step_origins(model, (sem_origin_rule)o.origin_rule, d, err);
     if (st == SEM_OK) st = sem_merge_degenerate_origins(d, err);
     if (st != SEM_OK) goto done;
     double t3 = omp_get_wtime();
@@ -512,6 +533,11 @@ sem_status sem_discretization_save(const sem_discretization *d, const char *path
     w_f64(&w, d->timings.weights_s);
     w_f64(&w, d->timings.build_pi_s);
     w_f64(&w, d->timings.operators_s);
+    w_doubles(&w, d->frame_axes, 9);
+    w_doubles(&w, d->frame_center, 3);
+    w_doubles(&w, d->frame_lo, 3);
+    w_doubles(&w, d->frame_hi, 3);
+    w_f64(&w, d->quad_spacing);
 
     w_ints(&w, d->part_ctrl_offset, d->part_ctrl_offset ? (size_t)d->n_parts + 1 : 0);
     w_ints(&w, d->sample_part, d->sample_part ? (size_t)d->n_samples : 0);
@@ -807,6 +833,22 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
     d->timings.weights_s = r_f64(&r);
     d->timings.build_pi_s = r_f64(&r);
     d->timings.operators_s = r_f64(&r);
+    {
+        struct {
+            double *dst;
+            size_t n;
+            const char *what;
+        } fixed[4] = {{d->frame_axes, 9, "frame_axes"},
+                      {d->frame_center, 3, "frame_center"},
+                      {d->frame_lo, 3, "frame_lo"},
+                      {d->frame_hi, 3, "frame_hi"}};
+        for (int k = 0; k < 4 && r.st == SEM_OK; ++k) {
+            double *v = r_doubles(&r, fixed[k].n, fixed[k].what);
+            if (v) memcpy(fixed[k].dst, v, fixed[k].n * sizeof *v);
+            free(v);
+        }
+    }
+    d->quad_spacing = r_f64(&r);
 
     if (r.st == SEM_OK) {
         size_t P = (size_t)d->n_parts, S = (size_t)d->n_samples, Q = (size_t)d->n_quad;

@@ -53,6 +53,13 @@
 
 #define WINDING_VETO 0.25  /* consistent counting: outside when the winding number is below */
 
+/* Automatic spacing of the object-frame grid: at most the longest extent / CELLS_LONGEST and
+ * the thinnest extent / CELLS_THINNEST (see the file comment). */
+#define CELLS_LONGEST 24
+#define CELLS_THINNEST 3
+/* Points of one interval at most (a guard; a sane grid never comes near). */
+#define MAX_POINTS_ALONG 100000
+
 typedef struct ray_points {
     int n;
     double *X;      /* 3 per point */
@@ -93,7 +100,8 @@ static int push_point(ray_points *r, int *cap, const double X[3], double volume,
  * [t_begin, t_end]. Returns 0 on out of memory. */
 static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3],
                           const double dir[3], double t_begin, double t_end, double length,
-                          int points_per_interval, double cell_area, ray_points *result)
+                          int points_per_interval, double h_along, double cell_area,
+                          ray_points *result)
 {
     sem_ray_hit local[64];
     sem_ray_hit *hits = local;
@@ -196,9 +204,14 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
         while (j + 1 < n_seg && seg[j + 1].inside) j++;
         double a = seg[i].t0, b = seg[j].t1;
         if (b > a) {
-            double h = (b - a) / points_per_interval;
+            int count = points_per_interval;
+            if (count <= 0) { /* as many as the interval holds at the grid's spacing */
+                double c = floor((b - a) / h_along + 0.5);
+                count = c < 1 ? 1 : (c > MAX_POINTS_ALONG ? MAX_POINTS_ALONG : (int)c);
+            }
+            double h = (b - a) / count;
             int s = i;
-            for (int k = 0; k < points_per_interval; k++) {
+            for (int k = 0; k < count; k++) {
                 double t = a + (k + 0.5) * h, X[3];
                 while (s < j && seg[s].t1 <= t) s++;
                 for (int d = 0; d < 3; d++) X[d] = origin[d] + t * dir[d];
@@ -218,6 +231,70 @@ done:
     return ok;
 }
 
+/* The ray grid: rays along axis[0] from (lo[0] - pad) through the cell centres of the
+ * n1 x n2 grid spanning [lo[1], hi[1]] x [lo[2], hi[2]] (coordinates along axis[k] relative to
+ * origin). */
+typedef struct ray_grid {
+    double origin[3];
+    double axis[3][3];
+    double lo[3], hi[3];
+    int n1, n2;
+    int points_per_interval; /* > 0: fixed count per interval */
+    double h_along;          /* else: point spacing along the rays */
+} ray_grid;
+
+static int cells(double extent, double h)
+{
+    double n = ceil(extent / h - 1e-9);
+    return n < 1 ? 1 : (n > 1e6 ? 1000000 : (int)n);
+}
+
+/* The grid of the options: the paper's explicit world-axis grid, or the object's frame. */
+static sem_status make_grid(const sem_raycast_scene *scene, const sem_preprocess_options *o,
+                            const sem_discretization *d, ray_grid *g, sem_error *err)
+{
+    memset(g, 0, sizeof *g);
+    g->points_per_interval = o->points_per_interval;
+    if (o->rays[0] > 0 || o->rays[1] > 0) {
+        double lo[3], hi[3];
+        sem_raycast_bounds(scene, lo, hi);
+        int a = o->ray_axis < 0 ? 0 : o->ray_axis;
+        int b = a == 0 ? 1 : 0;
+        int c = a == 2 ? 1 : 2;
+        int idx[3] = {a, b, c};
+        for (int k = 0; k < 3; ++k) {
+            g->axis[k][idx[k]] = 1.0;
+            g->lo[k] = lo[idx[k]];
+            g->hi[k] = hi[idx[k]];
+        }
+        g->n1 = o->rays[0];
+        g->n2 = o->rays[1];
+        g->h_along = 0.5 * ((g->hi[1] - g->lo[1]) / g->n1 + (g->hi[2] - g->lo[2]) / g->n2);
+    } else {
+        memcpy(g->origin, d->frame_center, sizeof g->origin);
+        for (int k = 0; k < 3; ++k) {
+            memcpy(g->axis[k], d->frame_axes + 3 * k, sizeof g->axis[k]);
+            g->lo[k] = d->frame_lo[k];
+            g->hi[k] = d->frame_hi[k];
+        }
+        double e0 = g->hi[0] - g->lo[0], e2 = g->hi[2] - g->lo[2];
+        double h = o->spacing > 0 ? o->spacing : fmin(e0 / CELLS_LONGEST, e2 / CELLS_THINNEST);
+        if (!(h > 0) || !isfinite(h))
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "quadrature: the model's extent is flat or empty "
+                                 "(%g x %g x %g): no volume to sample",
+                                 e0, g->hi[1] - g->lo[1], e2);
+        g->n1 = cells(g->hi[1] - g->lo[1], h);
+        g->n2 = cells(e2, h);
+        g->h_along = e0 / cells(e0, h);
+        if ((long long)g->n1 * g->n2 > 100000000LL)
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "quadrature: spacing %g gives %d x %d rays (more than 1e8)", h,
+                                 g->n1, g->n2);
+    }
+    return SEM_OK;
+}
+
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err)
@@ -225,32 +302,37 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     (void)model;
     if (!scene || !o || !d)
         return sem_error_set(err, SEM_ERR_INVALID, "quadrature: NULL scene, options or output");
-    if (o->rays[0] < 1 || o->rays[1] < 1 || o->rays[0] > 100000 || o->rays[1] > 100000 ||
+    if (o->rays[0] < 0 || o->rays[1] < 0 || o->rays[0] > 100000 || o->rays[1] > 100000 ||
         (long long)o->rays[0] * o->rays[1] > 100000000LL)
         return sem_error_set(err, SEM_ERR_INVALID, "quadrature: ray grid %d x %d is invalid",
                              o->rays[0], o->rays[1]);
-    if (o->ray_axis < 0 || o->ray_axis > 2)
+    if (o->ray_axis < -1 || o->ray_axis > 2)
         return sem_error_set(err, SEM_ERR_INVALID, "quadrature: ray axis %d is not 0, 1 or 2",
                              o->ray_axis);
-    if (o->points_per_interval < 1 || o->points_per_interval > 100000)
+    if (o->points_per_interval < 0 || o->points_per_interval > 100000)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "quadrature: points per interval %d is invalid",
                              o->points_per_interval);
 
-    double lo[3], hi[3];
-    sem_raycast_bounds(scene, lo, hi);
-    int a = o->ray_axis;
-    int b = a == 0 ? 1 : 0;
-    int c = a == 2 ? 1 : 2;
-    double wb = hi[b] - lo[b], wc = hi[c] - lo[c], wa = hi[a] - lo[a];
+    int have_frame = 0;
+    for (int k = 0; k < 9; ++k) have_frame |= d->frame_axes[k] != 0.0;
+    if (!have_frame) { /* a caller that runs the steps itself */
+        sem_status fst = sem_step_frame(scene, d, err);
+        if (fst != SEM_OK) return fst;
+    }
+    ray_grid g;
+    sem_status gst = make_grid(scene, o, d, &g, err);
+    if (gst != SEM_OK) return gst;
+    double wb = g.hi[1] - g.lo[1], wc = g.hi[2] - g.lo[2], wa = g.hi[0] - g.lo[0];
     if (!(wb > 0) || !(wc > 0) || !(wa > 0) || !isfinite(wa + wb + wc))
         return sem_error_set(err, SEM_ERR_INVALID,
                              "quadrature: the model's bounding box is flat or empty "
                              "(%g x %g x %g): no volume to sample",
-                             hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-    int n1 = o->rays[0], n2 = o->rays[1];
+                             wa, wb, wc);
+    int n1 = g.n1, n2 = g.n2;
     int n_rays = n1 * n2;
     double cell_area = (wb / n1) * (wc / n2);
+    d->quad_spacing = sqrt(cell_area);
     double diag = sqrt(wa * wa + wb * wb + wc * wc);
     double pad = 1e-3 * diag;
     double length = wa + 2 * pad;
@@ -258,18 +340,22 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     ray_points *rays = calloc((size_t)n_rays, sizeof *rays);
     if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     int failed = 0;
-    int ppi = o->points_per_interval;
+    int ppi = g.points_per_interval;
+    double h_along = g.h_along;
     /* a ray costs 5-20 us (exact hit refinement, winding-number vetoes), so even the
      * authors' small grids (81-180 rays) gain from a second thread: tire 1.1 -> 0.5 ms */
 #pragma omp parallel for schedule(dynamic, 4) reduction(| : failed) if (n_rays >= 16)
     for (int r = 0; r < n_rays; r++) {
         int i = r % n1, j = r / n1;
-        double origin[3], dir[3] = {0, 0, 0};
-        origin[a] = lo[a] - pad;
-        origin[b] = lo[b] + (i + 0.5) * (wb / n1);
-        origin[c] = lo[c] + (j + 0.5) * (wc / n2);
-        dir[a] = 1.0;
-        if (!quadrature_ray(scene, origin, dir, pad, pad + wa, length, ppi, cell_area, &rays[r]))
+        double s0 = g.lo[0] - pad, s1 = g.lo[1] + (i + 0.5) * (wb / n1),
+               s2 = g.lo[2] + (j + 0.5) * (wc / n2);
+        double origin[3], dir[3];
+        for (int k = 0; k < 3; ++k) {
+            origin[k] = g.origin[k] + s0 * g.axis[0][k] + s1 * g.axis[1][k] + s2 * g.axis[2][k];
+            dir[k] = g.axis[0][k];
+        }
+        if (!quadrature_ray(scene, origin, dir, pad, pad + wa, length, ppi, h_along, cell_area,
+                            &rays[r]))
             failed |= 1;
     }
 

@@ -1621,6 +1621,16 @@ void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[
 
 int sem_raycast_part_count(const sem_raycast_scene *scene) { return scene ? scene->n_parts : 0; }
 
+int sem_raycast_triangles(const sem_raycast_scene *scene, const double **triangles,
+                          const double **areas, const double **normals, const int **part_offset)
+{
+    if (triangles) *triangles = scene ? scene->tri : NULL;
+    if (areas) *areas = scene ? scene->tri_area : NULL;
+    if (normals) *normals = scene ? scene->tri_normal : NULL;
+    if (part_offset) *part_offset = scene ? scene->part_tri_offset : NULL;
+    return scene ? scene->n_triangles : 0;
+}
+
 int sem_raycast_part_sign(const sem_raycast_scene *scene, int part)
 {
     if (!scene || part < 0 || part >= scene->n_parts) return 1;

@@ -61,6 +61,11 @@ double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const do
 /* Bounding box of the tessellation: lo[3], hi[3]. */
 void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[3]);
 int sem_raycast_part_count(const sem_raycast_scene *scene);
+/* The tessellation's triangles, owned by the scene (read-only): 9 doubles each (v0, v1, v2),
+ * their areas, their unit normals before the orientation fix (3 each), and the triangles of
+ * part i are [part_offset[i], part_offset[i + 1]). Returns the triangle count. */
+int sem_raycast_triangles(const sem_raycast_scene *scene, const double **triangles,
+                          const double **areas, const double **normals, const int **part_offset);
 /* Orientation correction of a part, +1 or -1. */
 int sem_raycast_part_sign(const sem_raycast_scene *scene, int part);
 

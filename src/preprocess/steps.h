@@ -23,7 +23,14 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
  * allocated here (n_parts + 1 and n_samples entries); 0 when out of memory (none left). */
 int sem_samples_by_part(const sem_discretization *d, int **start, int **index);
 
-/* quadrature.c: fills n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11). */
+/* object_frame.c: fills frame_axes, frame_center, frame_lo, frame_hi from the scene's
+ * tessellation (principal axes of the surface, degenerate ones fixed by the normals). */
+sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d, sem_error *err);
+/* Coordinates of X along the frame's axes, relative to its centre. */
+void sem_frame_coordinates(const sem_discretization *d, const double X[3], double Y[3]);
+
+/* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
+ * needs the frame. */
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err);
@@ -41,7 +48,8 @@ sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const
 sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem_error *err);
 
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
-sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+sem_status sem_step_origins(const sem_model *model, sem_origin_rule rule, sem_discretization *d,
+                            sem_error *err);
 /* origins_merge.c: merges every origin whose samples are flat (planar or collinear) into
  * its most blended neighbour, so every linear fit is determined (affine-exact). */
 sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err);

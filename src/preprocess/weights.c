@@ -132,7 +132,8 @@ static scene_scale scene_scale_of(const sem_raycast_scene *scene)
 }
 
 /* Default cut-off when neither alpha nor a sparsity is given: half the median part size
- * (the diagonal of the bounding box of each part's boundary samples). The paper's own
+ * (the diagonal of the bounding box of each part's boundary samples, in the object's frame so
+ * that it does not change when the object is turned). The paper's own
  * settings are of that order (beams: 0.51 for 1 m faces). A model-wide scale such as half
  * the bounding-box diagonal blends far-away parts into every point; measured on the default
  * scene's 2 m beam (0.5 m sections), that made the clamped beam sag to a centre of mass 8 m
@@ -154,10 +155,11 @@ static double default_alpha(const sem_discretization *d, double fallback)
     }
     for (int k = 0; k < d->n_samples; ++k) {
         int i = d->sample_part[k];
+        double Y[3];
+        sem_frame_coordinates(d, d->sample_X + 3 * (size_t)k, Y);
         for (int e = 0; e < 3; ++e) {
-            double x = d->sample_X[3 * (size_t)k + e];
-            lo[3 * i + e] = fmin(lo[3 * i + e], x);
-            hi[3 * i + e] = fmax(hi[3 * i + e], x);
+            lo[3 * i + e] = fmin(lo[3 * i + e], Y[e]);
+            hi[3 * i + e] = fmax(hi[3 * i + e], Y[e]);
         }
     }
     int n = 0;

@@ -245,9 +245,9 @@ static sem_status parse_transform(ctx *c, const cJSON *t, const char *where, dou
 
 static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_preprocess_options *o)
 {
-    static const char *const keys[] = {"order", "alpha", "sparsity", "rays", "ray_axis",
-                                       "points_per_interval", "gamma", "tessellation",
-                                       "weight_threshold", NULL};
+    static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
+                                       "ray_axis", "points_per_interval", "gamma",
+                                       "tessellation", "weight_threshold", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -285,17 +285,31 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
         o->rays[0] = (int)rr[0];
         o->rays[1] = (int)rr[1];
     }
+    const cJSON *spc = cJSON_GetObjectItemCaseSensitive(s, "spacing");
+    if (spc && !cJSON_IsNull(spc)) {
+        if ((st = get_number(c, s, "spacing", where, &o->spacing)) != SEM_OK) return st;
+        snprintf(w, sizeof w, "%s.spacing", where);
+        if (!(o->spacing > 0)) return fail(c, w, "must be positive or null (got %g)", o->spacing);
+        if (r) return fail(c, where, "give either \"spacing\" or \"rays\", not both");
+    }
     const cJSON *ax = cJSON_GetObjectItemCaseSensitive(s, "ray_axis");
     if (ax) {
         snprintf(w, sizeof w, "%s.ray_axis", where);
         if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || !strchr("xyz", ax->valuestring[0]))
             return fail(c, w, "must be \"x\", \"y\" or \"z\"");
         o->ray_axis = ax->valuestring[0] - 'x';
+        if (!r)
+            return fail(c, w, "needs \"rays\" (without rays the grid is laid in the object's "
+                              "own frame)");
     }
-    if ((st = get_int(c, s, "points_per_interval", where, &o->points_per_interval)) != SEM_OK) return st;
-    if (o->points_per_interval < 1) {
-        snprintf(w, sizeof w, "%s.points_per_interval", where);
-        return fail(c, w, "must be at least 1");
+    const cJSON *ppi = cJSON_GetObjectItemCaseSensitive(s, "points_per_interval");
+    if (ppi && !cJSON_IsNull(ppi)) {
+        if ((st = get_int(c, s, "points_per_interval", where, &o->points_per_interval)) != SEM_OK)
+            return st;
+        if (o->points_per_interval < 1 || o->points_per_interval > 10000) {
+            snprintf(w, sizeof w, "%s.points_per_interval", where);
+            return fail(c, w, "must be in 1..10000 or null (got %d)", o->points_per_interval);
+        }
     }
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(s, "gamma");
     if (g && !cJSON_IsNull(g)) {
