@@ -80,7 +80,7 @@ static void test_hand_case(void)
     d.sample_area = sample_area;
     d.sample_part = sample_part;
     sem_error err;
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_OK, "%s", err.message);
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
     CHECK(d.n_origins == 4, "n_origins %d", d.n_origins);
     const int expect[5] = {0, 0, 1, 2, 3};
     for (int p = 0; p < 5; ++p)
@@ -109,7 +109,7 @@ static void test_hand_case(void)
     d.n_quad = 7;
     /* costs: {0,1}: p0 1.1 p1 0.9; {1,2}: p1 0.5 p2 0.5; {0,1,2}: p0 1.2 p1 0.4 p2 0.8
      * optimum: p0 -> {0,1}, p1 -> {0,1,2}, p2 -> {1,2}: origins {0}, {1}, {2}, {3}, {4} */
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_OK, "%s", err.message);
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
     CHECK(d.n_origins == 5, "n_origins %d", d.n_origins);
     for (int p = 0; p < 5 && d.part_origin; ++p)
         CHECK(d.part_origin[p] == p, "part %d origin %d", p, d.part_origin[p]);
@@ -121,21 +121,21 @@ static void test_hand_case(void)
     /* bad input: W of the wrong shape, sample of a part out of range */
     free_origins(&d);
     d.n_parts = 4;
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_ERR_INVALID, "W shape");
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_ERR_INVALID, "W shape");
     d.n_parts = 5;
     sample_part[2] = 9;
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_ERR_INVALID, "sample part");
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_ERR_INVALID, "sample part");
     CHECK(strstr(err.message, "sample") != NULL, "message: %s", err.message);
     sample_part[2] = 1;
     d.W.col[0] = 7;
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_ERR_INVALID, "W column");
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_ERR_INVALID, "W column");
     free_origins(&d);
     sem_csr_free(&d.W);
 
     /* no quadrature points at all: every part is isolated, at its own sample centroid */
     d.n_quad = 0;
     d.quad_X = NULL;
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_OK, "%s", err.message);
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
     CHECK(d.n_origins == 5, "empty W: %d origins", d.n_origins);
     if (d.n_origins == 5) CHECK_NEAR(d.origin_X[3 * 3 + 0], 8.0, 1e-12);
     free_origins(&d);
@@ -197,7 +197,7 @@ static void test_random(void)
     }
     sem_error err;
     double t0 = now();
-    CHECK(sem_step_origins(NULL, SEM_ORIGINS_PAPER, &d, &err) == SEM_OK, "%s", err.message);
+    CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
     printf("random: %d parts, %d points, %d origins, %.4f s\n", P, N, d.n_origins, now() - t0);
 
     /* group costs by set: recompute from the dense rows */
@@ -325,7 +325,7 @@ static void test_shared_models(void)
         double t0 = now();
         if (st == SEM_OK) st = sem_step_weights(m, scene, &o, d, &err);
         double t1 = now();
-        if (st == SEM_OK) st = sem_step_origins(m, o.origin_rule, d, &err);
+        if (st == SEM_OK) st = sem_step_origins(m, d, &err);
         double t2 = now();
         CHECK(st == SEM_OK, "%s: %s", models[i], err.message);
         if (st == SEM_OK) {

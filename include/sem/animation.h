@@ -21,6 +21,12 @@ typedef struct sem_animation_def {
     int write_iges, write_obj, write_mesh, write_usd;
     int mesh_resolution;     /* tessellation cells per knot span */
     double frames_per_second;
+    /* The models are in metres. Frame files (NURBS and meshes) are written in frame_units
+     * (an IGES unit name, e.g. "MM"; NULL or "": metres), numbers divided by
+     * frame_unit_to_meter, so a CAD tool shows the model at its size in its own units. The
+     * USD file is in metres (metersPerUnit 1). */
+    const char *frame_units;
+    double frame_unit_to_meter;
 } sem_animation_def;
 
 typedef struct sem_animation sem_animation;

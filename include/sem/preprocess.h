@@ -28,12 +28,14 @@
 extern "C" {
 #endif
 
-/* How each part is given its deformation origin among the candidate groups of Sec. 6.2 (both
- * solve the network of Eq. 10 with GLPK; see src/preprocess/origins.c). */
+/* How the parts are grouped into deformation origins (Sec. 6.2). */
 typedef enum sem_origin_rule {
-    SEM_ORIGINS_DOMINANT = 0, /* default: the group where the part's weight sum is largest, tied
-                                 groups merged (symmetric models stay symmetric) */
-    SEM_ORIGINS_PAPER = 1     /* the paper's cost: the group where it is smallest */
+    SEM_ORIGINS_COUPLED = 0, /* default: parts whose samples are (nearly) flat join the parts
+                                they blend with most, all at once and ties together, until every
+                                origin's samples span 3D (src/preprocess/origins_cluster.c):
+                                symmetric models stay symmetric */
+    SEM_ORIGINS_PAPER = 1    /* the paper's min-cost flow (Eq. 10, GLPK), then flat origins
+                                merged (src/preprocess/origins.c, origins_merge.c) */
 } sem_origin_rule;
 
 typedef struct sem_preprocess_options {
@@ -53,7 +55,7 @@ typedef struct sem_preprocess_options {
                                 when both are unset (alpha 0, sparsity 0): alpha = half
                                 the median part size (its samples' bbox diagonal) */
     double weight_threshold; /* weights below are dropped; default 1e-4 */
-    int origin_rule;         /* sem_origin_rule; default SEM_ORIGINS_DOMINANT */
+    int origin_rule;         /* sem_origin_rule; default SEM_ORIGINS_COUPLED */
     double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
     double youngs_modulus;   /* for the default gamma; default 1e6 */
     int tessellation;        /* triangle grid cells per knot span per direction; default 16 */

@@ -41,7 +41,13 @@ typedef struct sem_scene_object {
     double primitive_size[3];/* box size / beam length,width,height */
     double primitive_radius, primitive_radius2, primitive_height;
     int primitive_sections;
-    double transform[12];    /* 3 x 4 row-major [A | b], applied to the model */
+    double transform[12];    /* 3 x 4 row-major [A | b], applied to the model (in metres) */
+    /* "units": how the model file's numbers become metres. "" (default): the file's own
+     * units (IGES global section; OBJ "# sem units" comment; metres when the file says
+     * nothing); "as_metres": the numbers are metres whatever the file says (the paper's
+     * reading of its models); or a unit name ("mm", "cm", "m", "in", "ft", ...) that
+     * overrides the file. */
+    char units[16];
     sem_material material;
     int n_part_materials;
     sem_scene_part_material *part_materials;
@@ -83,9 +89,19 @@ void sem_scene_destroy(sem_scene *scene);
 /* The embedded default scene: a rubber beam clamped at x = 0 swinging under gravity. */
 const char *sem_scene_default_json(void);
 
-/* Loads or generates the object's model and applies its transform. */
+/* Loads or generates the object's model, converts it to metres (see units) and applies its
+ * transform: the model returned is in metres (units "M"). *file_unit_to_meter (may be NULL)
+ * receives the factor used and file_units (may be NULL, 16 chars) the file's unit name, so
+ * results can be written back in the file's own units (numbers / factor). */
+sem_status sem_scene_object_model_units(const sem_scene *scene, int object, sem_model **out,
+                                        double *file_unit_to_meter, char *file_units,
+                                        sem_error *err);
+/* The same without the units. */
 sem_status sem_scene_object_model(const sem_scene *scene, int object, sem_model **out,
                                   sem_error *err);
+/* Metres per unit of a unit name ("mm", "M", "inch", ...; case-insensitive), 0 if unknown.
+ * canonical (may be NULL, 16 chars) receives the IGES name ("MM", "M", "IN", ...). */
+double sem_unit_to_meter(const char *name, char *canonical);
 /* Per control point pin flags (1 = pinned) for the object's model; caller frees. */
 sem_status sem_scene_object_pins(const sem_scene_object *obj, const sem_model *model,
                                  unsigned char **out, sem_error *err);
@@ -129,6 +145,10 @@ const sem_scene *sem_scene_world_scene(const sem_scene_world *sw);
 int sem_scene_world_object_count(const sem_scene_world *sw);
 const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object);
 const sem_discretization *sem_scene_world_discretization(const sem_scene_world *sw, int object);
+/* The units the object's model file was read in (see sem_scene_object_model_units): frames
+ * are written back in them. */
+const char *sem_scene_world_file_units(const sem_scene_world *sw, int object);
+double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object);
 /* 1 when every object's discretization came from the cache. */
 int sem_scene_world_all_cached(const sem_scene_world *sw);
 /* Wall time spent loading models and preprocessing (or reading the cache), seconds. */

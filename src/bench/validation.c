@@ -55,6 +55,7 @@ sem_preprocess_options sem_cantilever_preprocess_options(const sem_cantilever_se
     po.alpha = s->alpha;
     po.youngs_modulus = s->youngs_modulus;
     po.threads = s->threads;
+    po.origin_rule = SEM_ORIGINS_PAPER; /* the authors' settings: the paper's origins (Eq. 10) */
     if (s->gamma > 0) po.gamma = s->gamma;
     return po;
 }
@@ -286,6 +287,7 @@ sem_preprocess_options sem_table1_options(const sem_table1_row *r)
     o.alpha = r->alpha;
     o.youngs_modulus = r->youngs_modulus;
     o.tessellation = 8;
+    o.origin_rule = SEM_ORIGINS_PAPER; /* the paper's min-cost flow (Eq. 10) */
     return o;
 }
 

@@ -107,9 +107,15 @@ static cJSON *summary(run_state *r, const char *status, const char *error)
         cJSON_AddNumberToObject(o, "quadrature_points", sem_scene_world_discretization(r->sw, i)->n_quad);
         cJSON_AddStringToObject(o, "solver", sem_world_solver_name(r->world, i));
         cJSON_AddNumberToObject(o, "nnz_percent", sem_world_object_nnz_percent(r->world, i));
+        cJSON_AddStringToObject(o, "file_units", sem_scene_world_file_units(r->sw, i));
+        cJSON_AddNumberToObject(o, "file_unit_to_meter", sem_scene_world_file_unit_to_meter(r->sw, i));
         cJSON_AddItemToArray(objs, o);
     }
     cJSON_AddStringToObject(s, "status", status);
+    /* every number below is SI (metres, kg, s); frame files are in frame_units */
+    cJSON_AddStringToObject(s, "units", "SI (m, kg, s)");
+    cJSON_AddStringToObject(s, "frame_units", sem_scene_world_file_units(r->sw, 0));
+    cJSON_AddNumberToObject(s, "frame_unit_to_meter", sem_scene_world_file_unit_to_meter(r->sw, 0));
     if (error) cJSON_AddStringToObject(s, "error", error);
     cJSON_AddNumberToObject(s, "volume", volume);
     cJSON_AddNumberToObject(s, "mass", mass);
@@ -243,6 +249,9 @@ int cmd_run(int argc, char **argv)
     ad.write_usd = r.scene->write_usd;
     ad.mesh_resolution = r.scene->mesh_resolution;
     ad.frames_per_second = 1.0 / (r.scene->world.dt * r.scene->steps_per_frame);
+    /* frames in the first object's file units (one unit per frame file) */
+    ad.frame_units = sem_scene_world_file_units(r.sw, 0);
+    ad.frame_unit_to_meter = sem_scene_world_file_unit_to_meter(r.sw, 0);
     st = sem_animation_create(&ad, r.n, models, &r.anim, &err);
     free(models);
     if (st != SEM_OK) {

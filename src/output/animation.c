@@ -2,6 +2,7 @@
 #include "sem/animation.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@ struct sem_animation {
     sem_animation_def def;
     char dir[4096];
     char usd_path[4200];
+    char frame_units[16];
     int n_objects;
     sem_model *combined;          /* all objects' parts, for the per-frame NURBS files */
     size_t *object_ctrl;          /* control points per object */
@@ -64,8 +66,16 @@ sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    snprintf(a->combined->units, sizeof a->combined->units, "%s", models[0]->units);
-    a->combined->unit_to_meter = models[0]->unit_to_meter;
+    if (!(a->def.frame_unit_to_meter > 0) || !isfinite(a->def.frame_unit_to_meter) ||
+        !a->def.frame_units || !a->def.frame_units[0]) {
+        a->def.frame_unit_to_meter = 1.0;
+        snprintf(a->frame_units, sizeof a->frame_units, "M");
+    } else {
+        snprintf(a->frame_units, sizeof a->frame_units, "%s", a->def.frame_units);
+    }
+    a->def.frame_units = a->frame_units;
+    snprintf(a->combined->units, sizeof a->combined->units, "%s", a->frame_units);
+    a->combined->unit_to_meter = a->def.frame_unit_to_meter;
     for (int o = 0; o < n_objects; ++o) {
         a->object_ctrl[o] = sem_model_control_points(models[o]);
         for (int i = 0; i < models[o]->n_parts; ++i)
@@ -115,8 +125,9 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
     double *all = malloc(3 * total * sizeof(double) + 1);
     if (!all) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     size_t k = 0;
+    const double to_frame = 1.0 / a->def.frame_unit_to_meter;
     for (int o = 0; o < a->n_objects; ++o) {
-        memcpy(all + 3 * k, q[o], 3 * a->object_ctrl[o] * sizeof(double));
+        for (size_t c = 0; c < 3 * a->object_ctrl[o]; ++c) all[3 * k + c] = q[o][c] * to_frame;
         k += a->object_ctrl[o];
     }
     sem_model_set_q(a->combined, all);
@@ -168,8 +179,9 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
                 return st;
             }
         }
-        if (pts)
-            for (int v = 0; v < 3 * a->meshes[o].n_vertices; ++v) pts[off++] = (float)a->meshes[o].positions[v];
+        if (pts) /* the USD file is in metres */
+            for (int v = 0; v < 3 * a->meshes[o].n_vertices; ++v)
+                pts[off++] = (float)(a->meshes[o].positions[v] * a->def.frame_unit_to_meter);
     }
     if (!pts) return SEM_OK;
     if (a->n_frames == a->cap_frames) {
@@ -203,7 +215,7 @@ sem_status sem_animation_finish(sem_animation *a, sem_error *err)
             "    timeCodesPerSecond = %.17g\n    framesPerSecond = %.17g\n    upAxis = \"Z\"\n"
             "    metersPerUnit = %.17g\n    doc = \"sem: Shape Matching Element Method animation\"\n)\n\n",
             first, last, a->def.frames_per_second, a->def.frames_per_second,
-            a->combined->unit_to_meter > 0 ? a->combined->unit_to_meter : 1.0);
+            1.0);
     fprintf(f, "def Xform \"World\"\n{\n");
     size_t off = 0;
     for (int o = 0; o < a->n_objects; ++o) {

@@ -272,3 +272,50 @@ void sem_frame_coordinates(const sem_discretization *d, const double X[3], doubl
     double r[3] = {X[0] - d->frame_center[0], X[1] - d->frame_center[1], X[2] - d->frame_center[2]};
     for (int a = 0; a < 3; ++a) Y[a] = dot3(d->frame_axes + 3 * a, r);
 }
+
+/* qsort comparator for doubles */
+static int double_cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+sem_status sem_part_sizes(const sem_discretization *d, double *size, double *median)
+{
+    int np = d->n_parts;
+    double *box = malloc(6 * (size_t)(np > 0 ? np : 1) * sizeof *box);
+    double *sorted = malloc((size_t)(np > 0 ? np : 1) * sizeof *sorted);
+    if (!box || !sorted) {
+        free(box);
+        free(sorted);
+        return SEM_ERR_NOMEM;
+    }
+    for (int i = 0; i < np; ++i)
+        for (int e = 0; e < 3; ++e) {
+            box[6 * i + e] = INFINITY;
+            box[6 * i + 3 + e] = -INFINITY;
+        }
+    for (int k = 0; k < d->n_samples; ++k) {
+        double Y[3];
+        sem_frame_coordinates(d, d->sample_X + 3 * (size_t)k, Y);
+        double *b = box + 6 * (size_t)d->sample_part[k];
+        for (int e = 0; e < 3; ++e) {
+            b[e] = fmin(b[e], Y[e]);
+            b[3 + e] = fmax(b[3 + e], Y[e]);
+        }
+    }
+    int n = 0;
+    for (int i = 0; i < np; ++i) {
+        const double *b = box + 6 * (size_t)i;
+        double s2 = 0;
+        for (int e = 0; e < 3; ++e) s2 += (b[3 + e] - b[e]) * (b[3 + e] - b[e]);
+        double s = b[3] >= b[0] ? sqrt(s2) : 0.0; /* a part without samples: 0 */
+        if (size) size[i] = s;
+        if (s > 0) sorted[n++] = s;
+    }
+    qsort(sorted, (size_t)n, sizeof *sorted, double_cmp);
+    if (median) *median = n > 0 ? sorted[n / 2] : 0.0;
+    free(box);
+    free(sorted);
+    return SEM_OK;
+}

@@ -32,14 +32,8 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Candidate costs of one part closer than this (relative) are a tie. Costs are sums of
- * blending weights, whose distances come from single-precision ray casts (~1e-7 relative);
- * distinct candidates of real models differ by far more. */
-#define TIE_RELATIVE 1e-4
 
 /* Data blocks attached to GLPK vertices and arcs (offsets passed to glp_mincost_okalg). */
 typedef struct flow_vertex {
@@ -164,34 +158,10 @@ fail:
     return -1;
 }
 
-/* The cost of giving a part the candidate where its weights sum to `weight`; `largest` is the
- * part's largest such sum over its candidates (the dominant rule's costs are then >= 0, and 0
- * for the part's best candidate). */
-static double arc_cost(sem_origin_rule rule, double weight, double largest)
-{
-    return rule == SEM_ORIGINS_PAPER ? weight : largest - weight;
-}
-
-/* Per part: the largest weight sum over its candidates (0 for parts in none). NULL when out
- * of memory. */
-static double *largest_weight_sums(const sem_discretization *d, const origin_group *groups,
-                                   int n_groups)
-{
-    double *largest = calloc((size_t)(d->n_parts > 0 ? d->n_parts : 1), sizeof *largest);
-    if (!largest) return NULL;
-    for (int g = 0; g < n_groups; ++g) {
-        const int *col = &d->W.col[d->W.row_start[groups[g].first_row]];
-        for (int k = 0; k < groups[g].n_parts; ++k)
-            largest[col[k]] = fmax(largest[col[k]], groups[g].cost[k]);
-    }
-    return largest;
-}
-
 /* Solves the network of the header; assigned[p] = group of part p (or -1 for parts in no
  * group). */
-static sem_status solve_assignment(const sem_discretization *d, sem_origin_rule rule,
-                                   const origin_group *groups, int n_groups, int *assigned,
-                                   sem_error *err)
+static sem_status solve_assignment(const sem_discretization *d, const origin_group *groups,
+                                   int n_groups, int *assigned, sem_error *err)
 {
     const int n_parts = d->n_parts;
     const sem_csr *W = &d->W;
@@ -200,11 +170,9 @@ static sem_status solve_assignment(const sem_discretization *d, sem_origin_rule 
 
     int *part_vertex = malloc((size_t)n_parts * sizeof *part_vertex);
     int *vertex_part = malloc(((size_t)n_parts + 1) * sizeof *vertex_part);
-    double *largest = largest_weight_sums(d, groups, n_groups);
-    if (!part_vertex || !vertex_part || !largest) {
+    if (!part_vertex || !vertex_part) {
         free(part_vertex);
         free(vertex_part);
-        free(largest);
         return sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
     }
     for (int p = 0; p < n_parts; ++p) part_vertex[p] = 0;
@@ -217,7 +185,7 @@ static sem_status solve_assignment(const sem_discretization *d, sem_origin_rule 
                 part_vertex[col[k]] = ++n_covered;
                 vertex_part[n_covered] = col[k];
             }
-            cost_total += arc_cost(rule, groups[g].cost[k], largest[col[k]]);
+            cost_total += groups[g].cost[k];
         }
     }
     /* vertices: 1 source, 2..n_groups+1 candidates, then parts, then the sink */
@@ -243,7 +211,7 @@ static sem_status solve_assignment(const sem_discretization *d, sem_origin_rule 
             fa = a->data;
             fa->low = 0.0;
             fa->cap = 1.0;
-            fa->cost = floor(arc_cost(rule, groups[g].cost[k], largest[col[k]]) * scale + 0.5);
+            fa->cost = floor(groups[g].cost[k] * scale + 0.5);
         }
     }
     for (int p = 0; p < n_parts; ++p) {
@@ -287,55 +255,12 @@ static sem_status solve_assignment(const sem_discretization *d, sem_origin_rule 
                                    "origins: min-cost flow left part %d without an origin", p);
     }
     glp_delete_graph(G);
-    free(largest);
     free(part_vertex);
     free(vertex_part);
     return st;
 }
 
-/* Union-find root with path halving. */
-static int find_root(int *parent, int g)
-{
-    while (parent[g] != g) {
-        parent[g] = parent[parent[g]];
-        g = parent[g];
-    }
-    return g;
-}
-
-/* Ties (see the file comment): every candidate whose cost for a part is within TIE_RELATIVE
- * of that part's best is one origin with the part's chosen candidate; assigned[] is rewritten
- * to the smallest candidate index of each merged class. */
-static sem_status merge_tied_candidates(const sem_discretization *d, const origin_group *groups,
-                                        int n_groups, int *assigned)
-{
-    if (n_groups <= 1) return SEM_OK;
-    int *parent = malloc((size_t)n_groups * sizeof *parent);
-    double *largest = largest_weight_sums(d, groups, n_groups);
-    if (!parent || !largest) {
-        free(parent);
-        free(largest);
-        return SEM_ERR_NOMEM;
-    }
-    for (int g = 0; g < n_groups; ++g) parent[g] = g;
-    for (int g = 0; g < n_groups; ++g) {
-        const int *col = &d->W.col[d->W.row_start[groups[g].first_row]];
-        for (int k = 0; k < groups[g].n_parts; ++k) {
-            const int p = col[k];
-            if (assigned[p] < 0 || groups[g].cost[k] < largest[p] * (1.0 - TIE_RELATIVE)) continue;
-            int a = find_root(parent, g), b = find_root(parent, assigned[p]);
-            if (a != b) parent[a > b ? a : b] = a < b ? a : b;
-        }
-    }
-    for (int p = 0; p < d->n_parts; ++p)
-        if (assigned[p] >= 0) assigned[p] = find_root(parent, assigned[p]);
-    free(parent);
-    free(largest);
-    return SEM_OK;
-}
-
-sem_status sem_step_origins(const sem_model *model, sem_origin_rule rule, sem_discretization *d,
-                            sem_error *err)
+sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err)
 {
     (void)model;
     if (!d) return sem_error_set(err, SEM_ERR_INVALID, "origins: missing discretization");
@@ -356,12 +281,8 @@ sem_status sem_step_origins(const sem_model *model, sem_origin_rule rule, sem_di
         st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
         goto done;
     }
-    st = solve_assignment(d, rule, groups, n_groups, assigned, err);
+    st = solve_assignment(d, groups, n_groups, assigned, err);
     if (st != SEM_OK) goto done;
-    if (rule == SEM_ORIGINS_DOMINANT && merge_tied_candidates(d, groups, n_groups, assigned) != SEM_OK) {
-        st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
-        goto done;
-    }
 
     /* number the origins by their smallest part index */
     for (int g = 0; g < n_groups; ++g) group_origin[g] = -1;

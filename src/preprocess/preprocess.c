@@ -62,7 +62,7 @@ sem_preprocess_options sem_default_preprocess_options(void)
     o.alpha = 0.0;    /* with sparsity 0: alpha = 0.5 x bbox diagonal (weights step) */
     o.sparsity = 0.0;
     o.weight_threshold = 1e-4;
-    o.origin_rule = SEM_ORIGINS_DOMINANT;
+    o.origin_rule = SEM_ORIGINS_COUPLED;
     o.gamma = 0.0;    /* default kappa E / L (operators step) */
     o.youngs_modulus = 1e6;
     o.tessellation = 16;
@@ -114,8 +114,8 @@ static sem_status validate_options(const sem_preprocess_options *o, sem_error *e
     if (!isfinite(o->weight_threshold) || o->weight_threshold < 0 || o->weight_threshold >= 1)
         return sem_error_set(err, SEM_ERR_INVALID, "weight threshold must be in [0,1) (got %g)",
                              o->weight_threshold);
-    if (o->origin_rule != SEM_ORIGINS_DOMINANT && o->origin_rule != SEM_ORIGINS_PAPER)
-        return sem_error_set(err, SEM_ERR_INVALID, "origin rule must be 0 (dominant) or 1 (paper) (got %d)",
+    if (o->origin_rule != SEM_ORIGINS_COUPLED && o->origin_rule != SEM_ORIGINS_PAPER)
+        return sem_error_set(err, SEM_ERR_INVALID, "origin rule must be 0 (coupled) or 1 (paper) (got %d)",
                              o->origin_rule);
     if (!isfinite(o->gamma) || o->gamma < 0)
         return sem_error_set(err, SEM_ERR_INVALID,
@@ -415,8 +415,12 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     int n_covered = 0;
     st = sem_cover_unweighted_parts(d, &n_covered, err);
     if (st != SEM_OK) goto done;
-    st = sem_step_origins(model, (sem_origin_rule)o.origin_rule, d, err);
-    if (st == SEM_OK) st = sem_merge_degenerate_origins(d, err);
+    if (o.origin_rule == SEM_ORIGINS_PAPER) {
+        st = sem_step_origins(model, d, err);
+        if (st == SEM_OK) st = sem_merge_degenerate_origins(d, err);
+    } else {
+        st = sem_step_origins_coupled(d, err);
+    }
     if (st != SEM_OK) goto done;
     double t3 = omp_get_wtime();
     d->timings.weights_s = t3 - t2;

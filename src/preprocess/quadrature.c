@@ -53,10 +53,12 @@
 
 #define WINDING_VETO 0.25  /* consistent counting: outside when the winding number is below */
 
-/* Automatic spacing of the object-frame grid: at most the longest extent / CELLS_LONGEST and
- * the thinnest extent / CELLS_THINNEST (see the file comment). */
-#define CELLS_LONGEST 24
+/* Automatic spacing of the object-frame grid (see the file comment): at most the thinnest
+ * extent / CELLS_THINNEST and the median part size / CELLS_PER_PART; at least what keeps the
+ * grid within MAX_AUTO_POINTS points of the bounding box. */
 #define CELLS_THINNEST 3
+#define CELLS_PER_PART 6
+#define MAX_AUTO_POINTS 60000.0
 /* Points of one interval at most (a guard; a sane grid never comes near). */
 #define MAX_POINTS_ALONG 100000
 
@@ -245,7 +247,7 @@ typedef struct ray_grid {
 
 static int cells(double extent, double h)
 {
-    double n = ceil(extent / h - 1e-9);
+    double n = ceil(extent / h * (1.0 - 1e-6)); /* an extent of exactly k cells (to rounding) is k */
     return n < 1 ? 1 : (n > 1e6 ? 1000000 : (int)n);
 }
 
@@ -277,8 +279,16 @@ static sem_status make_grid(const sem_raycast_scene *scene, const sem_preprocess
             g->lo[k] = d->frame_lo[k];
             g->hi[k] = d->frame_hi[k];
         }
-        double e0 = g->hi[0] - g->lo[0], e2 = g->hi[2] - g->lo[2];
-        double h = o->spacing > 0 ? o->spacing : fmin(e0 / CELLS_LONGEST, e2 / CELLS_THINNEST);
+        double e0 = g->hi[0] - g->lo[0], e1 = g->hi[1] - g->lo[1], e2 = g->hi[2] - g->lo[2];
+        double h = o->spacing;
+        if (!(h > 0)) {
+            double median = 0.0;
+            if (sem_part_sizes(d, NULL, &median) != SEM_OK)
+                return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
+            h = e2 / CELLS_THINNEST;
+            if (median > 0) h = fmin(h, median / CELLS_PER_PART);
+            h = fmax(h, cbrt(e0 * e1 * e2 / MAX_AUTO_POINTS));
+        }
         if (!(h > 0) || !isfinite(h))
             return sem_error_set(err, SEM_ERR_INVALID,
                                  "quadrature: the model's extent is flat or empty "

@@ -26,6 +26,10 @@ int sem_samples_by_part(const sem_discretization *d, int **start, int **index);
 /* object_frame.c: fills frame_axes, frame_center, frame_lo, frame_hi from the scene's
  * tessellation (principal axes of the surface, degenerate ones fixed by the normals). */
 sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d, sem_error *err);
+/* Size of every part (the diagonal of its boundary samples' bounding box in the frame, so it
+ * does not change when the object is turned; 0 for a part without samples) into size (may be
+ * NULL, n_parts entries) and the median over parts with samples into *median (may be NULL). */
+sem_status sem_part_sizes(const sem_discretization *d, double *size, double *median);
 /* Coordinates of X along the frame's axes, relative to its centre. */
 void sem_frame_coordinates(const sem_discretization *d, const double X[3], double Y[3]);
 
@@ -48,8 +52,10 @@ sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const
 sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem_error *err);
 
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
-sem_status sem_step_origins(const sem_model *model, sem_origin_rule rule, sem_discretization *d,
-                            sem_error *err);
+sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+/* origins_cluster.c: the default rule (SEM_ORIGINS_COUPLED): fills n_origins, origin_X,
+ * part_origin by merging flat groups of parts with the parts they blend with most. */
+sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err);
 /* origins_merge.c: merges every origin whose samples are flat (planar or collinear) into
  * its most blended neighbour, so every linear fit is determined (affine-exact). */
 sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err);

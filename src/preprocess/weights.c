@@ -140,45 +140,9 @@ static scene_scale scene_scale_of(const sem_raycast_scene *scene)
  * below the clamp in statics, against 0.5-0.7 m for alpha up to 0.4. */
 static double default_alpha(const sem_discretization *d, double fallback)
 {
-    int np = d->n_parts;
-    double *lo = malloc(6 * (size_t)(np > 0 ? np : 1) * sizeof(double));
-    double *size = malloc((size_t)(np > 0 ? np : 1) * sizeof(double));
-    if (!lo || !size) {
-        free(lo);
-        free(size);
-        return 0.5 * fallback;
-    }
-    double *hi = lo + 3 * (size_t)np;
-    for (int i = 0; i < 3 * np; ++i) {
-        lo[i] = INFINITY;
-        hi[i] = -INFINITY;
-    }
-    for (int k = 0; k < d->n_samples; ++k) {
-        int i = d->sample_part[k];
-        double Y[3];
-        sem_frame_coordinates(d, d->sample_X + 3 * (size_t)k, Y);
-        for (int e = 0; e < 3; ++e) {
-            lo[3 * i + e] = fmin(lo[3 * i + e], Y[e]);
-            hi[3 * i + e] = fmax(hi[3 * i + e], Y[e]);
-        }
-    }
-    int n = 0;
-    for (int i = 0; i < np; ++i) {
-        if (!(hi[3 * i] >= lo[3 * i])) continue;
-        double dx = hi[3 * i] - lo[3 * i], dy = hi[3 * i + 1] - lo[3 * i + 1], dz = hi[3 * i + 2] - lo[3 * i + 2];
-        double sz = sqrt(dx * dx + dy * dy + dz * dz);
-        /* insertion into the sorted prefix */
-        int j = n++;
-        while (j > 0 && size[j - 1] > sz) {
-            size[j] = size[j - 1];
-            --j;
-        }
-        size[j] = sz;
-    }
-    double alpha = n > 0 ? 0.5 * size[n / 2] : 0.5 * fallback;
-    free(lo);
-    free(size);
-    return alpha > 0 ? alpha : 0.5 * fallback;
+    double median = 0.0;
+    if (sem_part_sizes(d, NULL, &median) != SEM_OK || !(median > 0)) return 0.5 * fallback;
+    return 0.5 * median;
 }
 
 /* A radius that contains every part from X: distance to the bounding box plus its diagonal. */

@@ -8,6 +8,7 @@
 #include "sem/scene.h"
 
 #include <cjson/cJSON.h>
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -247,7 +248,7 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
 {
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
-                                       "tessellation", "weight_threshold", NULL};
+                                       "tessellation", "weight_threshold", "origins", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -284,6 +285,16 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
             return fail(c, w, "must be two integers in 1..10000");
         o->rays[0] = (int)rr[0];
         o->rays[1] = (int)rr[1];
+    }
+    const cJSON *orr = cJSON_GetObjectItemCaseSensitive(s, "origins");
+    if (orr) {
+        snprintf(w, sizeof w, "%s.origins", where);
+        if (cJSON_IsString(orr) && !strcmp(orr->valuestring, "coupled"))
+            o->origin_rule = SEM_ORIGINS_COUPLED;
+        else if (cJSON_IsString(orr) && !strcmp(orr->valuestring, "paper"))
+            o->origin_rule = SEM_ORIGINS_PAPER;
+        else
+            return fail(c, w, "must be \"coupled\" or \"paper\"");
     }
     const cJSON *spc = cJSON_GetObjectItemCaseSensitive(s, "spacing");
     if (spc && !cJSON_IsNull(spc)) {
@@ -428,7 +439,7 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     static const char *const keys[] = {"model", "primitive", "transform", "material",
                                        "part_materials", "sem", "pin", "prescribe",
                                        "initial_velocity", "initial_angular_velocity",
-                                       "point_loads", "region_loads", "gamma", NULL};
+                                       "point_loads", "region_loads", "gamma", "units", NULL};
     char where[64], w[256];
     snprintf(where, sizeof where, "objects[%d]", index);
     sem_status st = check_keys(c, o, where, keys);
@@ -438,6 +449,18 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     obj->sem = sem_default_preprocess_options();
     const cJSON *model = cJSON_GetObjectItemCaseSensitive(o, "model");
     const cJSON *prim = cJSON_GetObjectItemCaseSensitive(o, "primitive");
+    const cJSON *units = cJSON_GetObjectItemCaseSensitive(o, "units");
+    if (units) {
+        snprintf(w, sizeof w, "%s.units", where);
+        if (!cJSON_IsString(units) ||
+            (strcmp(units->valuestring, "as_metres") != 0 &&
+             !(sem_unit_to_meter(units->valuestring, NULL) > 0)))
+            return fail(c, w,
+                        "must be \"as_metres\" or a unit name (m, mm, cm, um, km, in, ft, mi, "
+                        "mil, uin)");
+        if (!model) return fail(c, w, "applies to a \"model\" file (primitives are in metres)");
+        snprintf(obj->units, sizeof obj->units, "%s", units->valuestring);
+    }
     if (!!model == !!prim) return fail(c, where, "needs exactly one of \"model\" or \"primitive\"");
     if (model) {
         snprintf(w, sizeof w, "%s.model", where);
@@ -899,7 +922,48 @@ static void apply_transform(sem_model *m, const double T[12])
     }
 }
 
+double sem_unit_to_meter(const char *name, char *canonical)
+{
+    static const struct {
+        const char *name, *iges;
+        double m;
+    } units[] = {{"M", "M", 1.0},          {"METER", "M", 1.0},     {"METRE", "M", 1.0},
+                 {"METERS", "M", 1.0},     {"METRES", "M", 1.0},    {"MM", "MM", 1e-3},
+                 {"CM", "CM", 1e-2},       {"KM", "KM", 1e3},       {"UM", "UM", 1e-6},
+                 {"MICRON", "UM", 1e-6},   {"IN", "IN", 0.0254},    {"INCH", "IN", 0.0254},
+                 {"INCHES", "IN", 0.0254}, {"FT", "FT", 0.3048},    {"FOOT", "FT", 0.3048},
+                 {"FEET", "FT", 0.3048},   {"MI", "MI", 1609.344},  {"MILE", "MI", 1609.344},
+                 {"MIL", "MIL", 2.54e-5},  {"UIN", "UIN", 2.54e-8}};
+    if (!name) return 0.0;
+    char up[32];
+    size_t n = strlen(name);
+    if (n == 0 || n >= sizeof up) return 0.0;
+    for (size_t k = 0; k <= n; ++k) up[k] = (char)toupper((unsigned char)name[k]);
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; ++i)
+        if (!strcmp(up, units[i].name)) {
+            if (canonical) snprintf(canonical, 16, "%s", units[i].iges);
+            return units[i].m;
+        }
+    return 0.0;
+}
+
+static void scale_model(sem_model *m, double f)
+{
+    if (f == 1.0) return;
+    for (int i = 0; i < m->n_parts; ++i) {
+        sem_surface *s = &m->parts[i].surface;
+        for (int c = 0; c < 3 * s->n_u * s->n_v; ++c) s->ctrl[c] *= f;
+    }
+}
+
 sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model **out, sem_error *err)
+{
+    return sem_scene_object_model_units(scene, index, out, NULL, NULL, err);
+}
+
+sem_status sem_scene_object_model_units(const sem_scene *scene, int index, sem_model **out,
+                                        double *file_unit_to_meter, char *file_units,
+                                        sem_error *err)
 {
     const sem_scene_object *o = &scene->objects[index];
     *out = NULL;
@@ -953,6 +1017,21 @@ sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model *
             return st;
         }
     }
+    /* to metres (the model's own units unless the scene says otherwise), then the transform,
+     * which is in metres */
+    char label[16];
+    snprintf(label, sizeof label, "%s", m->units[0] ? m->units : "M");
+    double f = m->unit_to_meter > 0 && isfinite(m->unit_to_meter) ? m->unit_to_meter : 1.0;
+    if (!strcmp(o->units, "as_metres")) {
+        f = 1.0;
+    } else if (o->units[0]) {
+        f = sem_unit_to_meter(o->units, label);
+    }
+    scale_model(m, f);
+    snprintf(m->units, sizeof m->units, "M");
+    m->unit_to_meter = 1.0;
+    if (file_unit_to_meter) *file_unit_to_meter = f;
+    if (file_units) snprintf(file_units, 16, "%s", label);
     apply_transform(m, o->transform);
     *out = m;
     return SEM_OK;

@@ -30,6 +30,8 @@ struct sem_scene_world {
     int **prescribe_group;
     sem_prescribe **prescribes;
     sem_material **materials;
+    double *file_unit_to_meter;
+    char (*file_units)[16];
     sem_world *world;
     int all_cached;
     double preprocess_s;
@@ -128,6 +130,8 @@ void sem_scene_world_destroy(sem_scene_world *sw)
     free(sw->prescribe_group);
     free(sw->prescribes);
     free(sw->materials);
+    free(sw->file_unit_to_meter);
+    free(sw->file_units);
     free(sw);
 }
 
@@ -138,11 +142,15 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     const sem_scene *scene = sw->scene;
     const char *name = scene->path[0] ? scene->path : "default scene";
     const sem_scene_object *so = &scene->objects[i];
-    sem_status st = sem_scene_object_model(scene, i, &sw->models[i], err);
+    sem_status st = sem_scene_object_model_units(scene, i, &sw->models[i],
+                                                 &sw->file_unit_to_meter[i], sw->file_units[i], err);
     if (st != SEM_OK) return st;
     const sem_model *model = sw->models[i];
     for (int k = 0; k < model->n_warnings; ++k)
         if (model->warnings[k]) logf_(o, 1, "%s", model->warnings[k]);
+    if (sw->file_unit_to_meter[i] != 1.0)
+        logf_(o, 0, "object %d: model file in %s: simulated in metres (x %g), frames written in %s",
+              i, sw->file_units[i], sw->file_unit_to_meter[i], sw->file_units[i]);
     logf_(o, 0, "object %d: %d parts, %zu dofs; preprocessing...", i, model->n_parts,
           3 * sem_model_control_points(model));
     int cached = 0;
@@ -208,9 +216,11 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
     sw->prescribe_group = calloc(n, sizeof *sw->prescribe_group);
     sw->prescribes = calloc(n, sizeof *sw->prescribes);
     sw->materials = calloc(n, sizeof *sw->materials);
+    sw->file_unit_to_meter = calloc(n, sizeof *sw->file_unit_to_meter);
+    sw->file_units = calloc(n, sizeof *sw->file_units);
     sem_status st = SEM_OK;
     if (!sw->models || !sw->discs || !sw->pins || !sw->part_material || !sw->prescribe_group ||
-        !sw->prescribes || !sw->materials) {
+        !sw->prescribes || !sw->materials || !sw->file_unit_to_meter || !sw->file_units) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -250,6 +260,18 @@ const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object)
 const sem_discretization *sem_scene_world_discretization(const sem_scene_world *sw, int object)
 {
     return sw && object >= 0 && object < sw->n ? sw->discs[object] : NULL;
+}
+
+const char *sem_scene_world_file_units(const sem_scene_world *sw, int object)
+{
+    return sw && object >= 0 && object < sw->n ? sw->file_units[object] : "M";
+}
+
+double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object)
+{
+    return sw && object >= 0 && object < sw->n && sw->file_unit_to_meter[object] > 0
+               ? sw->file_unit_to_meter[object]
+               : 1.0;
 }
 
 int sem_scene_world_all_cached(const sem_scene_world *sw) { return sw ? sw->all_cached : 0; }
