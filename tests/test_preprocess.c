@@ -51,8 +51,9 @@ static sem_preprocess_options fast_options(void)
 static void test_defaults(void)
 {
     sem_preprocess_options o = sem_default_preprocess_options();
-    CHECK(o.order == 2 && o.rays[0] == 40 && o.rays[1] == 40 && o.ray_axis == 0, "defaults");
-    CHECK(o.points_per_interval == 2 && o.alpha == 0 && o.sparsity == 0, "defaults");
+    CHECK(o.order == 2 && o.rays[0] == 0 && o.rays[1] == 0 && o.ray_axis == -1, "defaults");
+    CHECK(o.spacing == 0 && o.origin_rule == SEM_ORIGINS_COUPLED, "defaults");
+    CHECK(o.points_per_interval == 0 && o.alpha == 0 && o.sparsity == 0, "defaults");
     CHECK(o.weight_threshold == 1e-4 && o.gamma == 0 && o.youngs_modulus == 1e6, "defaults");
     CHECK(o.tessellation == 16 && o.threads == 0, "defaults");
 
@@ -108,8 +109,20 @@ static void test_bad_inputs(void)
     o.rays[1] = 0;
     expect_error(box, &o, "rays", "0 rays");
     o = fast_options();
-    o.points_per_interval = 0;
-    expect_error(box, &o, "points per interval", "0 points");
+    o.points_per_interval = -1;
+    expect_error(box, &o, "points per interval", "-1 points");
+    o = sem_default_preprocess_options();
+    o.ray_axis = 1;
+    expect_error(box, &o, "explicit rays grid", "axis without rays");
+    o = fast_options();
+    o.spacing = 0.1;
+    expect_error(box, &o, "not both", "spacing and rays");
+    o = sem_default_preprocess_options();
+    o.spacing = -0.1;
+    expect_error(box, &o, "spacing", "spacing < 0");
+    o = sem_default_preprocess_options();
+    o.origin_rule = 7;
+    expect_error(box, &o, "origin rule", "origin rule 7");
     o = fast_options();
     o.ray_axis = 3;
     expect_error(box, &o, "axis", "axis 3");
@@ -312,7 +325,7 @@ static void test_save_load(void)
     memcpy(data + 8, &version, 4);
     write_bytes(bad, data, (size_t)size);
     st = sem_discretization_load(bad, 0, &e, &err);
-    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 2"),
+    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 3"),
           "version message: %s", err.message);
     memcpy(data, "NOTSEM!!", 8);
     write_bytes(bad, data, (size_t)size);

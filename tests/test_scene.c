@@ -159,7 +159,9 @@ static void test_defaults_and_values(void)
     CHECK_NEAR(o->material.poisson_ratio, 0.45, 0);
     /* Lame parameters are set: mu = E / (2 (1 + nu)) */
     CHECK_REL(o->material.mu, 1e6 / 2.9, 1e-14);
-    CHECK(o->sem.order == 2 && o->sem.rays[0] == 40 && o->sem.points_per_interval == 2, "sem defaults");
+    CHECK(o->sem.order == 2 && o->sem.rays[0] == 0 && o->sem.points_per_interval == 0 &&
+              o->sem.spacing == 0 && o->sem.ray_axis == -1,
+          "sem defaults");
     CHECK(o->prescribe.type == SEM_PRESCRIBE_NONE && !o->has_pin_box && o->n_pin_parts == 0, "no pins");
     sem_scene_destroy(s);
 

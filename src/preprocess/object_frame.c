@@ -270,7 +270,9 @@ sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d,
 void sem_frame_coordinates(const sem_discretization *d, const double X[3], double Y[3])
 {
     double r[3] = {X[0] - d->frame_center[0], X[1] - d->frame_center[1], X[2] - d->frame_center[2]};
-    for (int a = 0; a < 3; ++a) Y[a] = dot3(d->frame_axes + 3 * a, r);
+    int have = 0;
+    for (int k = 0; k < 9; ++k) have |= d->frame_axes[k] != 0.0;
+    for (int a = 0; a < 3; ++a) Y[a] = have ? dot3(d->frame_axes + 3 * a, r) : r[a];
 }
 
 /* qsort comparator for doubles */

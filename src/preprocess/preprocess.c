@@ -414,6 +414,7 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     if (st != SEM_OK) goto done;
     int n_covered = 0;
     st = sem_cover_unweighted_parts(d, &n_covered, err);
+    if (st == SEM_OK) st = sem_step_point_materials(scene, d, err);
     if (st != SEM_OK) goto done;
     if (o.origin_rule == SEM_ORIGINS_PAPER) {
         st = sem_step_origins(model, d, err);

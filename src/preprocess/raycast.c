@@ -155,6 +155,7 @@ struct sem_raycast_scene {
     RTCScene scene;
     int n_parts;
     int *part_sign;       /* n_parts, +1/-1 */
+    int *part_component;  /* n_parts: smallest part index of the touching parts' component */
     int *part_tri_offset; /* n_parts + 1: part i owns triangles [off[i], off[i+1]) */
     int n_triangles;
     double *tri;          /* 9 per triangle: v0, v1, v2 */
@@ -1578,7 +1579,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     for (int p = 0; p < n_parts; p++) sign[p] = estimate_part_sign(s, component, p);
     memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
     free(sign);
-    free(component);
+    s->part_component = component;
     /* the winding-number tree depends on the corrected signs; the quadrature queries it for
      * every inside segment, so it is part of preparing the scene (out of memory: the
      * queries fall back to exact sums) */
@@ -1593,6 +1594,7 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     if (scene->scene) rtcReleaseScene(scene->scene);
     if (scene->device) rtcReleaseDevice(scene->device);
     free(scene->part_sign);
+    free(scene->part_component);
     free(scene->part_tri_offset);
     free(scene->tri);
     free(scene->tri_normal);
@@ -1620,6 +1622,12 @@ void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[
 }
 
 int sem_raycast_part_count(const sem_raycast_scene *scene) { return scene ? scene->n_parts : 0; }
+
+int sem_raycast_part_component(const sem_raycast_scene *scene, int part)
+{
+    if (!scene || !scene->part_component || part < 0 || part >= scene->n_parts) return part;
+    return scene->part_component[part];
+}
 
 int sem_raycast_triangles(const sem_raycast_scene *scene, const double **triangles,
                           const double **areas, const double **normals, const int **part_offset)

@@ -61,6 +61,10 @@ double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const do
 /* Bounding box of the tessellation: lo[3], hi[3]. */
 void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[3]);
 int sem_raycast_part_count(const sem_raycast_scene *scene);
+/* The component of a part: parts whose boundaries touch (within 5e-3 of the model size) form
+ * one component, named by its smallest part index (a box's six faces; a nested or embedded
+ * solid that does not touch the outer one is its own component). */
+int sem_raycast_part_component(const sem_raycast_scene *scene, int part);
 /* The tessellation's triangles, owned by the scene (read-only): 9 doubles each (v0, v1, v2),
  * their areas, their unit normals before the orientation fix (3 each), and the triangles of
  * part i are [part_offset[i], part_offset[i + 1]). Returns the triangle count. */

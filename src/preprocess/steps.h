@@ -30,7 +30,8 @@ sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d,
  * does not change when the object is turned; 0 for a part without samples) into size (may be
  * NULL, n_parts entries) and the median over parts with samples into *median (may be NULL). */
 sem_status sem_part_sizes(const sem_discretization *d, double *size, double *median);
-/* Coordinates of X along the frame's axes, relative to its centre. */
+/* Coordinates of X along the frame's axes, relative to its centre (world axes when the frame
+ * has not been computed: a caller running the steps by hand). */
 void sem_frame_coordinates(const sem_discretization *d, const double X[3], double Y[3]);
 
 /* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
@@ -38,6 +39,11 @@ void sem_frame_coordinates(const sem_discretization *d, const double X[3], doubl
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err);
+
+/* point_materials.c: rewrites quad_part, the quadrature's innermost entered part, to the
+ * part of that part's component with the largest weight at the point (needs W). */
+sem_status sem_step_point_materials(const sem_raycast_scene *scene, sem_discretization *d,
+                                    sem_error *err);
 
 /* weights.c: fills alpha, W, W_samples, weight_nonzero_fraction (Eq. 8-9). */
 sem_status sem_step_weights(const sem_model *model, const sem_raycast_scene *scene,
