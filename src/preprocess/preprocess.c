@@ -422,6 +422,8 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     } else {
         st = sem_step_origins_coupled(d, err);
     }
+    int n_ties = 0;
+    if (st == SEM_OK) st = sem_tie_translation_components(d, &n_ties, err);
     if (st != SEM_OK) goto done;
     double t3 = omp_get_wtime();
     d->timings.weights_s = t3 - t2;

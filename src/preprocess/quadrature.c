@@ -61,26 +61,10 @@
 #define MAX_AUTO_POINTS 60000.0
 /* Points of one interval at most (a guard; a sane grid never comes near). */
 #define MAX_POINTS_ALONG 100000
-/* Object-frame grid: rays per column per direction (SUBRAYS^2 per column), and the smallest
- * inside volume of a cell, as a fraction of the cell, that makes a point. */
-#define SUBRAYS 4
-#define MIN_CELL_FRACTION 1e-9
 
-typedef struct ray_points {
-    int n;
-    double *X;      /* 3 per point */
-    double *volume;
-    int *part;
-} ray_points;
-
-typedef struct ray_segment {
-    double t0, t1;
-    int inside;
-    int part;
-} ray_segment;
 
 /* Appends one point to a ray's result (geometric growth). Returns 0 on out of memory. */
-static int push_point(ray_points *r, int *cap, const double X[3], double volume, int part)
+static int push_point(sem_ray_points *r, int *cap, const double X[3], double volume, int part)
 {
     if (r->n == *cap) {
         int c = *cap ? 2 * *cap : 16;
@@ -107,9 +91,9 @@ static int push_point(ray_points *r, int *cap, const double X[3], double volume,
  * bounding box for t in [t_begin, t_end]. *seg is allocated (n + 1 segments: [t_begin,
  * hit 0], [hit 0, hit 1], ..., [hit n-1, t_end]); *n_seg 0 when the ray hits nothing. Returns 0
  * on out of memory. */
-static int ray_segments(const sem_raycast_scene *scene, const double origin[3],
+int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[3],
                         const double dir[3], double t_begin, double t_end, double length,
-                        ray_segment **seg_out, int *n_seg_out)
+                             sem_ray_segment **seg_out, int *n_seg_out)
 {
     *seg_out = NULL;
     *n_seg_out = 0;
@@ -130,7 +114,7 @@ static int ray_segments(const sem_raycast_scene *scene, const double origin[3],
     int ok = 1;
     /* the stack holds (component, part entered through) */
     int *stack = malloc(2 * (size_t)n * sizeof *stack);
-    ray_segment *seg = malloc((size_t)(n + 1) * sizeof *seg);
+    sem_ray_segment *seg = malloc((size_t)(n + 1) * sizeof *seg);
     if (!stack || !seg) {
         ok = 0;
         free(seg);
@@ -220,11 +204,11 @@ done:
 static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3],
                           const double dir[3], double t_begin, double t_end, double length,
                           int points_per_interval, double h_along, double cell_area,
-                          ray_points *result)
+                          sem_ray_points *result)
 {
-    ray_segment *seg;
+    sem_ray_segment *seg;
     int n_seg;
-    if (!ray_segments(scene, origin, dir, t_begin, t_end, length, &seg, &n_seg)) return 0;
+    if (!sem_ray_inside_segments(scene, origin, dir, t_begin, t_end, length, &seg, &n_seg)) return 0;
     int ok = 1, cap = 0, i = 0;
     while (i < n_seg && ok) {
         if (!seg[i].inside) {
@@ -258,108 +242,6 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
     return ok;
 }
 
-/* Per column of the object-frame grid: each cell's inside volume, first moment and the
- * inside length of each part's material (a few parts per cell; linear lists). */
-typedef struct cell_accumulator {
-    int n_cells;
-    double *volume;   /* n_cells */
-    double *moment;   /* 3 n_cells */
-    int n_entries, cap_entries;
-    int *entry_cell, *entry_part;
-    double *entry_len;
-} cell_accumulator;
-
-static int accumulate_part(cell_accumulator *c, int cell, int part, double len)
-{
-    for (int e = c->n_entries - 1; e >= 0 && c->entry_cell[e] == cell; --e)
-        if (c->entry_part[e] == part) {
-            c->entry_len[e] += len;
-            return 1;
-        }
-    if (c->n_entries == c->cap_entries) {
-        int nc = c->cap_entries ? 2 * c->cap_entries : 64;
-        int *ec = realloc(c->entry_cell, (size_t)nc * sizeof *ec);
-        if (!ec) return 0;
-        c->entry_cell = ec;
-        int *ep = realloc(c->entry_part, (size_t)nc * sizeof *ep);
-        if (!ep) return 0;
-        c->entry_part = ep;
-        double *el = realloc(c->entry_len, (size_t)nc * sizeof *el);
-        if (!el) return 0;
-        c->entry_len = el;
-        c->cap_entries = nc;
-    }
-    c->entry_cell[c->n_entries] = cell;
-    c->entry_part[c->n_entries] = part;
-    c->entry_len[c->n_entries++] = len;
-    return 1;
-}
-
-/* One column (i, j) of the object-frame grid, n_along cells of length h_along: SUBRAYS x
- * SUBRAYS rays through the column, each inside segment's length summed into the cells it
- * crosses; every cell with inside volume gets one point at the centroid of that volume,
- * taking the material of the part with the longest inside length in it. Returns 0 on out of
- * memory. */
-static int quadrature_column(const sem_raycast_scene *scene, const double grid_origin[3],
-                             const double axis[3][3], double s0, double s1, double s2, double cb,
-                             double cc, int n_along, double h_along, double pad, double length,
-                             cell_accumulator *acc, ray_points *result)
-{
-    acc->n_cells = n_along;
-    memset(acc->volume, 0, (size_t)n_along * sizeof *acc->volume);
-    memset(acc->moment, 0, 3 * (size_t)n_along * sizeof *acc->moment);
-    acc->n_entries = 0;
-    const double sub_area = (cb / SUBRAYS) * (cc / SUBRAYS);
-    const double *dir = axis[0];
-    for (int v = 0; v < SUBRAYS; ++v)
-        for (int u = 0; u < SUBRAYS; ++u) {
-            double b = s1 + (u + 0.5) * cb / SUBRAYS, c = s2 + (v + 0.5) * cc / SUBRAYS;
-            double origin[3];
-            for (int k = 0; k < 3; ++k)
-                origin[k] = grid_origin[k] + s0 * axis[0][k] + b * axis[1][k] + c * axis[2][k];
-            ray_segment *seg;
-            int n_seg;
-            if (!ray_segments(scene, origin, dir, pad, length - pad, length, &seg, &n_seg)) return 0;
-            for (int i = 0; i < n_seg; ++i) {
-                if (!seg[i].inside || !(seg[i].t1 > seg[i].t0)) continue;
-                /* the segment in cell coordinates along the column (t = pad at the box) */
-                double a0 = (seg[i].t0 - pad) / h_along, a1 = (seg[i].t1 - pad) / h_along;
-                int k0 = (int)floor(fmax(a0, 0.0)), k1 = (int)floor(fmin(a1, (double)n_along));
-                if (k0 >= n_along) k0 = n_along - 1;
-                for (int k = k0 < 0 ? 0 : k0; k <= k1 && k < n_along; ++k) {
-                    double t0 = fmax(seg[i].t0, pad + k * h_along);
-                    double t1 = fmin(seg[i].t1, pad + (k + 1) * h_along);
-                    if (!(t1 > t0)) continue;
-                    double vol = (t1 - t0) * sub_area, tm = 0.5 * (t0 + t1);
-                    acc->volume[k] += vol;
-                    for (int e = 0; e < 3; ++e) acc->moment[3 * k + e] += vol * (origin[e] + tm * dir[e]);
-                    if (!accumulate_part(acc, k, seg[i].part, t1 - t0)) {
-                        free(seg);
-                        return 0;
-                    }
-                }
-            }
-            free(seg);
-        }
-    /* one point per cell with volume; cells in order along the axis */
-    int cap = 0, ok = 1;
-    const double cell_volume = h_along * cb * cc;
-    for (int k = 0; k < n_along && ok; ++k) {
-        if (!(acc->volume[k] > MIN_CELL_FRACTION * cell_volume)) continue;
-        int part = -1;
-        double best = -1;
-        for (int e = 0; e < acc->n_entries; ++e)
-            if (acc->entry_cell[e] == k && acc->entry_len[e] > best) {
-                best = acc->entry_len[e];
-                part = acc->entry_part[e];
-            }
-        double X[3];
-        for (int e = 0; e < 3; ++e) X[e] = acc->moment[3 * k + e] / acc->volume[k];
-        ok = push_point(result, &cap, X, acc->volume[k], part);
-    }
-    return ok;
-}
-
 /* The ray grid: rays along axis[0] from (lo[0] - pad) through the cell centres of the
  * n1 x n2 grid spanning [lo[1], hi[1]] x [lo[2], hi[2]] (coordinates along axis[k] relative to
  * origin). */
@@ -370,7 +252,7 @@ typedef struct ray_grid {
     int n1, n2;
     int points_per_interval; /* > 0: fixed count per interval */
     double h_along;          /* else: point spacing along the rays */
-    int cells_along;         /* > 0: object-frame grid of cells (quadrature_column) */
+    double cell_size;        /* > 0: the object-frame grid of cells (quadrature_cells.c) */
 } ray_grid;
 
 static int cells(double extent, double h)
@@ -424,9 +306,9 @@ static sem_status make_grid(const sem_raycast_scene *scene, const sem_preprocess
                                  e0, g->hi[1] - g->lo[1], e2);
         g->n1 = cells(g->hi[1] - g->lo[1], h);
         g->n2 = cells(e2, h);
-        g->cells_along = cells(e0, h);
-        g->h_along = e0 / g->cells_along;
-        if (o->points_per_interval > 0) g->cells_along = 0; /* the paper's points along rays */
+        g->h_along = e0 / cells(e0, h);
+        /* with a fixed count per interval: the paper's points along the rays of this grid */
+        if (o->points_per_interval == 0) g->cell_size = h;
         if ((long long)g->n1 * g->n2 > 100000000LL)
             return sem_error_set(err, SEM_ERR_INVALID,
                                  "quadrature: spacing %g gives %d x %d rays (more than 1e8)", h,
@@ -478,37 +360,25 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     double pad = 1e-3 * diag;
     double length = wa + 2 * pad;
 
-    ray_points *rays = calloc((size_t)n_rays, sizeof *rays);
-    if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     int failed = 0;
     int ppi = g.points_per_interval;
     double h_along = g.h_along;
-    if (g.cells_along > 0) {
-        /* object-frame grid: SUBRAYS^2 rays per column, one point per cell */
-        const int n_along = g.cells_along;
-#pragma omp parallel reduction(| : failed)
-        {
-            cell_accumulator acc;
-            memset(&acc, 0, sizeof acc);
-            acc.volume = malloc((size_t)n_along * sizeof *acc.volume);
-            acc.moment = malloc(3 * (size_t)n_along * sizeof *acc.moment);
-            if (!acc.volume || !acc.moment) failed |= 1;
-#pragma omp for schedule(dynamic, 1)
-            for (int r = 0; r < n_rays; r++) {
-                if (!acc.volume || !acc.moment) continue;
-                int i = r % n1, j = r / n1;
-                if (!quadrature_column(scene, g.origin, (const double(*)[3])g.axis, g.lo[0] - pad,
-                                       g.lo[1] + i * (wb / n1), g.lo[2] + j * (wc / n2), wb / n1,
-                                       wc / n2, n_along, h_along, pad, length, &acc, &rays[r]))
-                    failed |= 1;
+    sem_ray_points *rays = NULL;
+    if (g.cell_size > 0) {
+        /* the object-frame grid of cells (quadrature_cells.c): points per column */
+        sem_status cst = sem_quadrature_cells(scene, g.cell_size, d, &rays, &n_rays, err);
+        if (cst != SEM_OK) {
+            for (int r = 0; rays && r < n_rays; r++) {
+                free(rays[r].X);
+                free(rays[r].volume);
+                free(rays[r].part);
             }
-            free(acc.volume);
-            free(acc.moment);
-            free(acc.entry_cell);
-            free(acc.entry_part);
-            free(acc.entry_len);
+            free(rays);
+            return cst;
         }
     } else {
+        rays = calloc((size_t)n_rays, sizeof *rays);
+        if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     /* a ray costs 5-20 us (exact hit refinement, winding-number vetoes), so even the
      * authors' small grids (81-180 rays) gain from a second thread: tire 1.1 -> 0.5 ms */
 #pragma omp parallel for schedule(dynamic, 4) reduction(| : failed) if (n_rays >= 16)

@@ -34,6 +34,36 @@ sem_status sem_part_sizes(const sem_discretization *d, double *size, double *med
  * has not been computed: a caller running the steps by hand). */
 void sem_frame_coordinates(const sem_discretization *d, const double X[3], double Y[3]);
 
+/* Points of one ray or one column of cells, before concatenation (quadrature*.c). */
+typedef struct sem_ray_points {
+    int n;
+    double *X;      /* 3 per point */
+    double *volume;
+    int *part;
+} sem_ray_points;
+
+/* A piece of a ray between two hits: inside the solid or not, and the part whose material it
+ * takes (the innermost entered component's entering part). */
+typedef struct sem_ray_segment {
+    double t0, t1;
+    int inside;
+    int part;
+} sem_ray_segment;
+
+/* quadrature.c: the inside segments of one ray through the box [t_begin, t_end] (CSG union by
+ * enter/leave counting, winding-number fallback and veto; see quadrature.c). *seg is
+ * allocated (n_hits + 1 segments, *n_seg 0 when nothing is hit). Returns 0 when out of
+ * memory. */
+int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[3],
+                            const double dir[3], double t_begin, double t_end, double length,
+                            sem_ray_segment **seg, int *n_seg);
+
+/* quadrature_cells.c: the default quadrature, cells of size h in the object's frame refined near
+ * small parts, one point per cell: *columns gets one sem_ray_points per column (caller frees),
+ * sets quad_spacing. */
+sem_status sem_quadrature_cells(const sem_raycast_scene *scene, double h, sem_discretization *d,
+                                sem_ray_points **columns, int *n_columns, sem_error *err);
+
 /* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
  * needs the frame. */
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
@@ -65,6 +95,10 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err);
 /* origins_merge.c: merges every origin whose samples are flat (planar or collinear) into
  * its most blended neighbour, so every linear fit is determined (affine-exact). */
 sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err);
+
+/* origins_tie.c: merges origins so that no group of touching parts can translate against the
+ * rest at no energy (Eq. 15 keeps weights constant); *n_ties counts the merges. */
+sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, sem_error *err);
 
 /* projection.c: fills Pi (Eq. 7), hierarchical, robust to ill-conditioned fits. */
 sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretization *d,
