@@ -895,7 +895,6 @@ const char *sem_scene_default_json(void)
            "  \"objects\": [{\n"
            "    \"primitive\": {\"type\": \"beam\", \"sections\": 4, \"length\": 2.0, \"width\": 0.4, \"height\": 0.4},\n"
            "    \"material\": {\"type\": \"neohookean\", \"density\": 1100, \"youngs_modulus\": 2e6, \"poisson_ratio\": 0.45},\n"
-           "    \"sem\": {\"order\": 2, \"rays\": [4, 4], \"points_per_interval\": 12},\n"
            "    \"pin\": {\"box\": [[-0.01, -1, -1], [0.01, 1, 1]]}\n"
            "  }],\n"
            "  \"gravity\": [0, 0, -9.81],\n"
