@@ -28,7 +28,7 @@
 #include "steps.h"
 
 /* A boundary sample couples two origins when both carry at least this weight there. */
-#define TIE_WEIGHT 1e-3
+#define TIE_WEIGHT 0.05
 
 typedef struct origin_pair {
     int a, b;   /* origins, a < b */

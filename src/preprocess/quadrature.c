@@ -321,7 +321,6 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err)
 {
-    (void)model;
     if (!scene || !o || !d)
         return sem_error_set(err, SEM_ERR_INVALID, "quadrature: NULL scene, options or output");
     int explicit_grid = o->rays[0] != 0 || o->rays[1] != 0;
@@ -366,7 +365,7 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     sem_ray_points *rays = NULL;
     if (g.cell_size > 0) {
         /* the object-frame grid of cells (quadrature_cells.c): points per column */
-        sem_status cst = sem_quadrature_cells(scene, g.cell_size, d, &rays, &n_rays, err);
+        sem_status cst = sem_quadrature_cells(model, scene, g.cell_size, d, &rays, &n_rays, err);
         if (cst != SEM_OK) {
             for (int r = 0; rays && r < n_rays; r++) {
                 free(rays[r].X);

@@ -31,10 +31,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sem/nurbs.h"
 #include "steps.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
 #define SMALL_PART_CELLS 3.0 /* a part asks for cells of at most its size / this */
+#define THIN_CELLS 2.0       /* and of at most the thickness of the solid behind it / this */
 #define MAX_LEVEL 3          /* sub-cells per base cell per direction: at most 2^3 */
 #define MIN_CELL_FRACTION 1e-9
 #define MAX_POINTS 2000000.0 /* refinement is coarsened until the cells fit */
@@ -213,9 +215,65 @@ static int clamp_index(double x, int n)
     return (int)x;
 }
 
+/* The thickness of the solid behind each part: the median over its samples of the distance
+ * from the sample inwards (against the orientation-corrected normal) to the next surface;
+ * INFINITY when nothing is hit (an open sheet). */
+static int part_thickness(const sem_model *model, const sem_raycast_scene *scene,
+                          const sem_discretization *d, double *thick)
+{
+    const int np = d->n_parts;
+    int *start = calloc((size_t)np + 1, sizeof *start);
+    double *dist = malloc((size_t)(d->n_samples > 0 ? d->n_samples : 1) * sizeof *dist);
+    if (!start || !dist) {
+        free(start);
+        free(dist);
+        return 0;
+    }
+    for (int s = 0; s < d->n_samples; ++s) start[d->sample_part[s] + 1]++;
+    for (int p = 0; p < np; ++p) start[p + 1] += start[p];
+    double lo[3], hi[3];
+    sem_raycast_bounds(scene, lo, hi);
+    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int p = 0; p < np; ++p) {
+        int n = 0;
+        double *dp = dist + start[p];
+        const sem_surface *surf = &model->parts[p].surface;
+        int sign = sem_raycast_part_sign(scene, p);
+        for (int s = 0; s < d->n_samples; ++s) { /* samples of part p, in sample order */
+            if (d->sample_part[s] != p) continue;
+            double nrm[3];
+            if (!(sem_surface_normal(surf, d->sample_uv[2 * (size_t)s], d->sample_uv[2 * (size_t)s + 1], nrm) > 0))
+                continue;
+            double dir[3] = {-sign * nrm[0], -sign * nrm[1], -sign * nrm[2]};
+            sem_ray_hit hit;
+            if (sem_raycast_first(scene, d->sample_X + 3 * (size_t)s, dir, 1e-6 * diag, 2 * diag, &hit))
+                dp[n++] = hit.t;
+            else
+                dp[n++] = INFINITY;
+        }
+        /* median (insertion sort: a part has at most a few hundred samples) */
+        for (int i = 1; i < n; ++i) {
+            double x = dp[i];
+            int j = i;
+            while (j > 0 && dp[j - 1] > x) {
+                dp[j] = dp[j - 1];
+                --j;
+            }
+            dp[j] = x;
+        }
+        thick[p] = n > 0 ? dp[n / 2] : INFINITY;
+    }
+    free(start);
+    free(dist);
+    return 1;
+}
+
 /* Marks the base cells near every part smaller than the cells; returns the number of cells
  * the refined grid would have at most (upper bound), or -1 when out of memory. */
-static double refine(const sem_discretization *d, cell_grid *g, int max_level)
+static double refine(const sem_discretization *d, const double *thick, cell_grid *g,
+                     int max_level)
 {
     const int np = d->n_parts;
     const size_t n_base = (size_t)g->n[0] * g->n[1] * g->n[2];
@@ -248,7 +306,7 @@ static double refine(const sem_discretization *d, cell_grid *g, int max_level)
     }
     const double h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     for (int p = 0; p < np; ++p) {
-        double want = size[p] / SMALL_PART_CELLS;
+        double want = fmin(size[p] / SMALL_PART_CELLS, thick[p] / THIN_CELLS);
         if (!(size[p] > 0) || !(want < h)) continue;
         int l = (int)ceil(log2(h / want) - 1e-9);
         if (l > max_level) l = max_level;
@@ -273,8 +331,9 @@ static double refine(const sem_discretization *d, cell_grid *g, int max_level)
     return total;
 }
 
-sem_status sem_quadrature_cells(const sem_raycast_scene *scene, double h, sem_discretization *d,
-                                sem_ray_points **columns_out, int *n_columns_out, sem_error *err)
+sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene *scene, double h,
+                                sem_discretization *d, sem_ray_points **columns_out,
+                                int *n_columns_out, sem_error *err)
 {
     *columns_out = NULL;
     *n_columns_out = 0;
@@ -299,15 +358,24 @@ sem_status sem_quadrature_cells(const sem_raycast_scene *scene, double h, sem_di
                              "quadrature: spacing %g gives %d x %d x %d cells (more than %g)", h,
                              g.n[0], g.n[1], g.n[2], MAX_POINTS);
     g.level = calloc(n_base, 1);
-    if (!g.level) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
+    double *thick = malloc((size_t)(d->n_parts > 0 ? d->n_parts : 1) * sizeof *thick);
+    if (!g.level || !thick || (model && !part_thickness(model, scene, d, thick))) {
+        free(g.level);
+        free(thick);
+        return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
+    }
+    if (!model)
+        for (int p = 0; p < d->n_parts; ++p) thick[p] = INFINITY;
     for (int max_level = MAX_LEVEL; max_level >= 0; --max_level) {
-        double cells = refine(d, &g, max_level);
+        double cells = refine(d, thick, &g, max_level);
         if (cells < 0) {
             free(g.level);
+            free(thick);
             return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
         }
         if (cells <= MAX_POINTS) break;
     }
+    free(thick);
     const int n_columns = g.n[1] * g.n[2];
     sem_ray_points *cols = calloc((size_t)n_columns, sizeof *cols);
     if (!cols) {

@@ -59,10 +59,11 @@ int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[
                             sem_ray_segment **seg, int *n_seg);
 
 /* quadrature_cells.c: the default quadrature, cells of size h in the object's frame refined near
- * small parts, one point per cell: *columns gets one sem_ray_points per column (caller frees),
+ * small parts and thin solids (model may be NULL: no thickness), one point per cell: *columns gets one sem_ray_points per column (caller frees),
  * sets quad_spacing. */
-sem_status sem_quadrature_cells(const sem_raycast_scene *scene, double h, sem_discretization *d,
-                                sem_ray_points **columns, int *n_columns, sem_error *err);
+sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene *scene, double h,
+                                sem_discretization *d, sem_ray_points **columns, int *n_columns,
+                                sem_error *err);
 
 /* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
  * needs the frame. */
