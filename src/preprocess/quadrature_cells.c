@@ -31,12 +31,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sem/nurbs.h"
+#include <lapacke.h>
+
 #include "steps.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
 #define SMALL_PART_CELLS 3.0 /* a part asks for cells of at most its size / this */
-#define THIN_CELLS 2.0       /* and of at most the thickness of the solid behind it / this */
+#define THIN_STD 0.2         /* a cell's inside volume thinner than this x the cell (standard
+                                deviation along a principal direction) gets two points across */
 #define MAX_LEVEL 3          /* sub-cells per base cell per direction: at most 2^3 */
 #define MIN_CELL_FRACTION 1e-9
 #define MAX_POINTS 2000000.0 /* refinement is coarsened until the cells fit */
@@ -57,6 +59,7 @@ static int entry_cmp(const void *a, const void *b)
 typedef struct column_buffers {
     int cap_cells;
     double *volume, *moment; /* cap_cells, 3 cap_cells */
+    double *second;          /* 6 cap_cells: xx yy zz xy xz yz, about the column origin */
     int *offset;             /* cells along + 1 */
     int n_entries, cap_entries;
     cell_entry *entries;
@@ -118,6 +121,49 @@ static int push_point(sem_ray_points *r, int *cap, const double X[3], double vol
     return 1;
 }
 
+/* The point(s) of one cell: its inside volume's centroid, or, where that volume is thin along
+ * principal directions (a wall, a fin, a rod narrower than ~0.7 cells: standard deviation below
+ * THIN_STD of the cell size h), two points across each thin direction at centroid +- one
+ * standard deviation with the volume shared equally: the two-point Gauss rule along that
+ * direction, which matches the volume's first and second moments. One point at the middle of a
+ * wall would see no bending strain (it sits on the neutral surface), so walls thinner than a
+ * cell would have zero-energy bending modes. Returns 0 on out of memory. */
+static int emit_cell(const column_buffers *b, int cell, const double col_origin[3], double h,
+                     int part, sem_ray_points *result, int *cap)
+{
+    const double V = b->volume[cell];
+    double c[3], C[9];
+    for (int e = 0; e < 3; ++e) c[e] = b->moment[3 * (size_t)cell + e] / V;
+    const double *s2 = b->second + 6 * (size_t)cell;
+    C[0] = s2[0] / V - c[0] * c[0];
+    C[4] = s2[1] / V - c[1] * c[1];
+    C[8] = s2[2] / V - c[2] * c[2];
+    C[1] = C[3] = s2[3] / V - c[0] * c[1];
+    C[2] = C[6] = s2[4] / V - c[0] * c[2];
+    C[5] = C[7] = s2[5] / V - c[1] * c[2];
+    double w[3];
+    int thin[3] = {0, 0, 0}, n_thin = 0;
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', 3, C, 3, w) == 0)
+        for (int a = 0; a < 3; ++a) {
+            thin[a] = w[a] < (THIN_STD * h) * (THIN_STD * h);
+            n_thin += thin[a];
+        }
+    if (n_thin == 3) n_thin = 0; /* a speck: one point */
+    const int n_points = 1 << n_thin;
+    for (int k = 0; k < n_points; ++k) {
+        double X[3] = {c[0], c[1], c[2]};
+        int bit = 0;
+        for (int a = 0; a < 3 && n_thin > 0; ++a) {
+            if (!thin[a]) continue;
+            double sgn = (k >> bit++) & 1 ? 1.0 : -1.0, sd = sqrt(fmax(w[a], 0.0));
+            for (int e = 0; e < 3; ++e) X[e] += sgn * sd * C[3 * e + a]; /* column a: eigenvector */
+        }
+        for (int e = 0; e < 3; ++e) X[e] += col_origin[e];
+        if (!push_point(result, cap, X, V / n_points, part)) return 0;
+    }
+    return 1;
+}
+
 /* The points of column (i, j). Returns 0 on out of memory. */
 static int column(const sem_raycast_scene *scene, const cell_grid *g, int i, int j,
                   column_buffers *b, sem_ray_points *result)
@@ -135,14 +181,21 @@ static int column(const sem_raycast_scene *scene, const cell_grid *g, int i, int
     double *m = realloc(b->moment, 3 * (size_t)b->cap_cells * sizeof *m);
     if (!m) return 0;
     b->moment = m;
+    double *m2 = realloc(b->second, 6 * (size_t)b->cap_cells * sizeof *m2);
+    if (!m2) return 0;
+    b->second = m2;
     memset(b->volume, 0, (size_t)n_cells * sizeof *b->volume);
     memset(b->moment, 0, 3 * (size_t)n_cells * sizeof *b->moment);
+    memset(b->second, 0, 6 * (size_t)n_cells * sizeof *b->second);
     b->n_entries = 0;
 
     const int S = SUBRAYS << L;
     const double h0 = g->h[0], sub_area = (g->h[1] / S) * (g->h[2] / S);
     const double *dir = g->axis[0];
     const double s0 = g->lo[0] - g->pad, s1 = g->lo[1] + i * g->h[1], s2 = g->lo[2] + j * g->h[2];
+    double col_origin[3]; /* moments about the column's corner: small numbers, no cancellation */
+    for (int e = 0; e < 3; ++e)
+        col_origin[e] = g->origin[e] + g->lo[0] * g->axis[0][e] + s1 * g->axis[1][e] + s2 * g->axis[2][e];
     for (int v = 0; v < S; ++v)
         for (int u = 0; u < S; ++u) {
             double cb = s1 + (u + 0.5) * g->h[1] / S, cc = s2 + (v + 0.5) * g->h[2] / S;
@@ -169,8 +222,19 @@ static int column(const sem_raycast_scene *scene, const cell_grid *g, int i, int
                         int cell = b->offset[k] + (a * ns + bi) * ns + ci;
                         double vol = (t1 - t0) * sub_area, tm = 0.5 * (t0 + t1);
                         b->volume[cell] += vol;
-                        for (int e = 0; e < 3; ++e)
-                            b->moment[3 * (size_t)cell + e] += vol * (origin[e] + tm * dir[e]);
+                        double x[3];
+                        for (int e = 0; e < 3; ++e) {
+                            x[e] = origin[e] + tm * dir[e] - col_origin[e];
+                            b->moment[3 * (size_t)cell + e] += vol * x[e];
+                        }
+                        /* int (x x^T) over the segment: length (m m^T + L^2/12 d d^T) */
+                        double L12 = (t1 - t0) * (t1 - t0) / 12.0, *s2 = b->second + 6 * (size_t)cell;
+                        s2[0] += vol * (x[0] * x[0] + L12 * dir[0] * dir[0]);
+                        s2[1] += vol * (x[1] * x[1] + L12 * dir[1] * dir[1]);
+                        s2[2] += vol * (x[2] * x[2] + L12 * dir[2] * dir[2]);
+                        s2[3] += vol * (x[0] * x[1] + L12 * dir[0] * dir[1]);
+                        s2[4] += vol * (x[0] * x[2] + L12 * dir[0] * dir[2]);
+                        s2[5] += vol * (x[1] * x[2] + L12 * dir[1] * dir[2]);
                         if (!push_entry(b, cell, seg[q].part, t1 - t0)) {
                             free(seg);
                             return 0;
@@ -200,9 +264,7 @@ static int column(const sem_raycast_scene *scene, const cell_grid *g, int i, int
                 }
             }
             if (!(b->volume[cell] > MIN_CELL_FRACTION * cell_volume) || part < 0) continue;
-            double X[3];
-            for (int c = 0; c < 3; ++c) X[c] = b->moment[3 * (size_t)cell + c] / b->volume[cell];
-            if (!push_point(result, &cap, X, b->volume[cell], part)) return 0;
+            if (!emit_cell(b, cell, col_origin, cbrt(cell_volume), part, result, &cap)) return 0;
         }
     }
     return 1;
@@ -215,65 +277,9 @@ static int clamp_index(double x, int n)
     return (int)x;
 }
 
-/* The thickness of the solid behind each part: the median over its samples of the distance
- * from the sample inwards (against the orientation-corrected normal) to the next surface;
- * INFINITY when nothing is hit (an open sheet). */
-static int part_thickness(const sem_model *model, const sem_raycast_scene *scene,
-                          const sem_discretization *d, double *thick)
-{
-    const int np = d->n_parts;
-    int *start = calloc((size_t)np + 1, sizeof *start);
-    double *dist = malloc((size_t)(d->n_samples > 0 ? d->n_samples : 1) * sizeof *dist);
-    if (!start || !dist) {
-        free(start);
-        free(dist);
-        return 0;
-    }
-    for (int s = 0; s < d->n_samples; ++s) start[d->sample_part[s] + 1]++;
-    for (int p = 0; p < np; ++p) start[p + 1] += start[p];
-    double lo[3], hi[3];
-    sem_raycast_bounds(scene, lo, hi);
-    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int p = 0; p < np; ++p) {
-        int n = 0;
-        double *dp = dist + start[p];
-        const sem_surface *surf = &model->parts[p].surface;
-        int sign = sem_raycast_part_sign(scene, p);
-        for (int s = 0; s < d->n_samples; ++s) { /* samples of part p, in sample order */
-            if (d->sample_part[s] != p) continue;
-            double nrm[3];
-            if (!(sem_surface_normal(surf, d->sample_uv[2 * (size_t)s], d->sample_uv[2 * (size_t)s + 1], nrm) > 0))
-                continue;
-            double dir[3] = {-sign * nrm[0], -sign * nrm[1], -sign * nrm[2]};
-            sem_ray_hit hit;
-            if (sem_raycast_first(scene, d->sample_X + 3 * (size_t)s, dir, 1e-6 * diag, 2 * diag, &hit))
-                dp[n++] = hit.t;
-            else
-                dp[n++] = INFINITY;
-        }
-        /* median (insertion sort: a part has at most a few hundred samples) */
-        for (int i = 1; i < n; ++i) {
-            double x = dp[i];
-            int j = i;
-            while (j > 0 && dp[j - 1] > x) {
-                dp[j] = dp[j - 1];
-                --j;
-            }
-            dp[j] = x;
-        }
-        thick[p] = n > 0 ? dp[n / 2] : INFINITY;
-    }
-    free(start);
-    free(dist);
-    return 1;
-}
-
 /* Marks the base cells near every part smaller than the cells; returns the number of cells
  * the refined grid would have at most (upper bound), or -1 when out of memory. */
-static double refine(const sem_discretization *d, const double *thick, cell_grid *g,
-                     int max_level)
+static double refine(const sem_discretization *d, cell_grid *g, int max_level)
 {
     const int np = d->n_parts;
     const size_t n_base = (size_t)g->n[0] * g->n[1] * g->n[2];
@@ -306,7 +312,7 @@ static double refine(const sem_discretization *d, const double *thick, cell_grid
     }
     const double h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     for (int p = 0; p < np; ++p) {
-        double want = fmin(size[p] / SMALL_PART_CELLS, thick[p] / THIN_CELLS);
+        double want = size[p] / SMALL_PART_CELLS;
         if (!(size[p] > 0) || !(want < h)) continue;
         int l = (int)ceil(log2(h / want) - 1e-9);
         if (l > max_level) l = max_level;
@@ -357,25 +363,17 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
         return sem_error_set(err, SEM_ERR_INVALID,
                              "quadrature: spacing %g gives %d x %d x %d cells (more than %g)", h,
                              g.n[0], g.n[1], g.n[2], MAX_POINTS);
+    (void)model;
     g.level = calloc(n_base, 1);
-    double *thick = malloc((size_t)(d->n_parts > 0 ? d->n_parts : 1) * sizeof *thick);
-    if (!g.level || !thick || (model && !part_thickness(model, scene, d, thick))) {
-        free(g.level);
-        free(thick);
-        return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
-    }
-    if (!model)
-        for (int p = 0; p < d->n_parts; ++p) thick[p] = INFINITY;
+    if (!g.level) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     for (int max_level = MAX_LEVEL; max_level >= 0; --max_level) {
-        double cells = refine(d, thick, &g, max_level);
+        double cells = refine(d, &g, max_level);
         if (cells < 0) {
             free(g.level);
-            free(thick);
             return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
         }
         if (cells <= MAX_POINTS) break;
     }
-    free(thick);
     const int n_columns = g.n[1] * g.n[2];
     sem_ray_points *cols = calloc((size_t)n_columns, sizeof *cols);
     if (!cols) {
@@ -397,6 +395,7 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
         free(b.offset);
         free(b.volume);
         free(b.moment);
+        free(b.second);
         free(b.entries);
     }
     free(g.level);
