@@ -92,16 +92,19 @@ sem_status render_input_mesh(const render_input *in, int k, sem_model *model, se
     return sem_mesh_update(in->tmpl, model, mesh, err);
 }
 
-/* Reads frames first.., keeps their control points and the box of their meshes. */
+/* Reads every frame of the run: keeps the control points of frames first.. and the box of
+ * all frames' meshes, so that the camera is the same whichever frames are drawn (frame k
+ * alone gives the same picture as frame k of the whole run). */
 static sem_status read_frames(render_input *in, sem_error *err)
 {
+    const int n_all = in->is_run ? in->run.n_frames : in->count;
     in->q = malloc(3 * in->n_ctrl * (size_t)in->count * sizeof *in->q);
     if (!in->q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory (%d frames)", in->count);
     for (int k = 0; k < 3; ++k) {
         in->bounds[k] = INFINITY;
         in->bounds[k + 3] = -INFINITY;
     }
-    int failed_frame = in->count; /* the lowest failing frame reports */
+    int failed_frame = n_all; /* the lowest failing frame reports */
     sem_error first_error;
     sem_error_clear(&first_error);
 #pragma omp parallel
@@ -110,16 +113,19 @@ static sem_status read_frames(render_input *in, sem_error *err)
         sem_mesh mesh;
         memset(&mesh, 0, sizeof mesh);
         double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+        double *q_other = malloc(3 * in->n_ctrl * sizeof *q_other); /* frames not drawn */
         sem_error e;
         sem_error_clear(&e);
-        int ok = scratch && sem_mesh_template_mesh(in->tmpl, &mesh, &e) == SEM_OK;
-        if (!scratch) sem_error_set(&e, SEM_ERR_NOMEM, "out of memory");
+        int ok = scratch && q_other && sem_mesh_template_mesh(in->tmpl, &mesh, &e) == SEM_OK;
+        if (!scratch || !q_other) sem_error_set(&e, SEM_ERR_NOMEM, "out of memory");
 #pragma omp for schedule(dynamic, 1)
-        for (int k = 0; k < in->count; ++k) {
+        for (int frame = 0; frame < n_all; ++frame) {
+            const int k = frame - in->first, drawn = k >= 0 && k < in->count;
+            double *q = drawn ? &in->q[3 * in->n_ctrl * (size_t)k] : q_other;
             int bad = !ok;
             if (!bad) {
                 char path[4200];
-                run_folder_frame_path(&in->run, in->first + k, path, sizeof path);
+                run_folder_frame_path(&in->run, frame, path, sizeof path);
                 sem_model *m = NULL;
                 if (sem_model_load(path, &m, &e) != SEM_OK) {
                     bad = 1;
@@ -129,8 +135,9 @@ static sem_status read_frames(render_input *in, sem_error *err)
                                   path, m->n_parts, in->rest->n_parts);
                     bad = 1;
                 } else {
-                    sem_model_get_q(m, &in->q[3 * in->n_ctrl * (size_t)k]);
-                    if (render_input_mesh(in, k, scratch, &mesh, &e) != SEM_OK)
+                    sem_model_get_q(m, q);
+                    sem_model_set_q(scratch, q);
+                    if (sem_mesh_update(in->tmpl, scratch, &mesh, &e) != SEM_OK)
                         bad = 1;
                     else
                         bounds_add(box, &mesh);
@@ -139,8 +146,8 @@ static sem_status read_frames(render_input *in, sem_error *err)
             }
             if (bad) {
 #pragma omp critical(render_input_error)
-                if (k < failed_frame) {
-                    failed_frame = k;
+                if (frame < failed_frame) {
+                    failed_frame = frame;
                     first_error = e;
                 }
             }
@@ -152,8 +159,9 @@ static sem_status read_frames(render_input *in, sem_error *err)
         }
         sem_mesh_free(&mesh);
         sem_model_destroy(scratch);
+        free(q_other);
     }
-    if (failed_frame < in->count) {
+    if (failed_frame < n_all) {
         if (err) *err = first_error;
         return first_error.status != SEM_OK ? first_error.status : SEM_ERR_INVALID;
     }
