@@ -30,8 +30,9 @@ typedef struct render_input {
     double bounds[6];           /* box of every frame's tessellation */
 } render_input;
 
-/* A run folder: frames first..last (last < 0: to the end), all read (in parallel) and
- * checked to have frame 0's parts. */
+/* A run folder: the frames to draw are first..last (last < 0: to the end); every frame is
+ * read (in parallel), checked to have frame 0's parts, and counted in the box the camera
+ * frames. */
 sem_status render_input_open_run(const char *dir, int first, int last, int resolution,
                                  render_input *in, sem_error *err);
 /* One model at rest. */
