@@ -141,7 +141,7 @@ try {
           args: ['--headless=new', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader',
                  '--enable-unsafe-swiftshader', '--disable-quic', '--no-first-run',
                  '--disable-background-networking', '--disable-component-update', '--disable-sync',
-                 '--window-size=1000,800', `--user-data-dir=${profile}`]
+                 '--disable-dev-shm-usage', '--window-size=1000,800', `--user-data-dir=${profile}`]
         }
       }
     }
