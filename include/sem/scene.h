@@ -72,6 +72,7 @@ typedef struct sem_scene {
     int steps_per_frame;
     char output_dir[4096];
     int write_iges, write_obj, write_mesh, write_usd;
+    int write_glb;           /* output.glb: animation.glb */
     int mesh_resolution;
 } sem_scene;
 

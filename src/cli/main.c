@@ -59,6 +59,29 @@ static const cli_command commands[] = {
      "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
      "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
     {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (5)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
+    {"render", cmd_render, "OUT_DIR | MODEL_FILE [-o OUT] [--mp4 FILE] [--size W H] [--frames A:B] [--camera AZ,EL[,DIST] | --camera EX,EY,EZ,TX,TY,TZ] [--color part|material|weights:PART|origins|quadrature]",
+     "ray-traced pictures of a run's frames (PNG, optionally an MP4 video) or of a model at rest",
+     "  OUT_DIR      a folder written by sem run: every frame -> OUT_DIR/render/frame_NNNN.png\n"
+     "  MODEL_FILE   a model (.igs/.iges, .obj): one picture of it at rest (default MODEL.png)\n"
+     "  -o OUT       the pictures' folder (a run) or the picture's file (a model)\n"
+     "  --mp4 FILE   also encode the frames as an H.264 video with ffmpeg\n"
+     "  --size W H   picture size in pixels (1280 720)\n"
+     "  --frames A:B only frames A..B (A:, :B and A also work)\n"
+     "  --camera AZ,EL[,DIST]       orbit camera: azimuth and elevation in degrees (-60,25), distance\n"
+     "                              (default: the whole animation fills the picture)\n"
+     "  --camera EX,EY,EZ,TX,TY,TZ  look-at camera: eye and target points\n"
+     "  --color MODE part (default), material, weights:PART (blending weights of one part),\n"
+     "               origins (deformation origins), quadrature (volume quadrature points)\n"
+     "  --disc FILE  preprocessed data for a model's diagnostic colours (sem preprocess --save);\n"
+     "               without it the model is preprocessed with the default settings\n"
+     "  --resolution N  tessellation cells per knot span (8)   --quiet  no progress output\n"},
+    {"view", cmd_view, "OUT_DIR [-o FILE]",
+     "write OUT_DIR/viewer.html: the animation in the browser (offline, self-contained)",
+     "  OUT_DIR   a folder written by sem run (needs its animation.glb; summary.json gives the\n"
+     "            energy plot)\n"
+     "  -o FILE   write the page there instead of OUT_DIR/viewer.html\n"
+     "  The page bundles three.js from the Debian package libjs-three\n"
+     "  (/usr/share/javascript/three; SEM_THREE_DIR overrides the folder).\n"},
 };
 
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);

@@ -722,7 +722,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
     if (desc && !cJSON_IsString(desc)) return fail(c, "description", "must be a string");
     const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
     if (out) {
-        static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "mesh_resolution", NULL};
+        static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "glb", "mesh_resolution", NULL};
         if ((st = check_keys(c, out, "output", keys)) != SEM_OK) return st;
         const cJSON *d = cJSON_GetObjectItemCaseSensitive(out, "dir");
         if (d) {
@@ -733,6 +733,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
         if ((st = get_bool(c, out, "obj", "output", &s->write_obj)) != SEM_OK) return st;
         if ((st = get_bool(c, out, "mesh", "output", &s->write_mesh)) != SEM_OK) return st;
         if ((st = get_bool(c, out, "usd", "output", &s->write_usd)) != SEM_OK) return st;
+        if ((st = get_bool(c, out, "glb", "output", &s->write_glb)) != SEM_OK) return st;
         if ((st = get_int(c, out, "mesh_resolution", "output", &s->mesh_resolution)) != SEM_OK) return st;
         if (s->mesh_resolution < 1 || s->mesh_resolution > 64) return fail(c, "output.mesh_resolution", "must be in 1..64");
     }
@@ -787,6 +788,7 @@ sem_status sem_scene_parse(const char *json, const char *name, const char *base_
     s->write_obj = 0;
     s->write_mesh = 1;
     s->write_usd = 1;
+    s->write_glb = 1;
     s->mesh_resolution = 6;
     static const char *const keys[] = {"objects", "gravity", "integrator", "frames",
                                        "steps_per_frame", "output", "threads", "description", NULL};
