@@ -16,10 +16,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-
-#ifndef SEM_VERSION_STRING
-#define SEM_VERSION_STRING "unknown"
-#endif
+#include "sem/version.h"
 
 typedef struct cli_command {
     const char *name;
@@ -188,7 +185,7 @@ static void print_help(FILE *f)
             "       sem --version\n"
             "\n"
             "commands:\n",
-            SEM_VERSION_STRING);
+            sem_version());
     for (int i = 0; i < n_commands; ++i)
         fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 }
@@ -247,7 +244,7 @@ int main(int argc, char **argv)
         return CLI_OK;
     }
     if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
-        printf("sem %s\n", SEM_VERSION_STRING);
+        printf("sem %s%s\n", sem_version(), sem_has_step() ? "" : " (without STEP: built without Open CASCADE)");
         return CLI_OK;
     }
     const cli_command *c = find_command(name);

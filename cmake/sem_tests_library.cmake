@@ -1,0 +1,41 @@
+# sem_tests_library.cmake - tests of sem as a library others build on (CTest):
+#   test_install        install into build/install-test, build tests/install/consumer.c with
+#                       pkg-config and with find_package(sem), run them, and import the
+#                       installed Python package
+#   test_python         the Python package's pytest suite (python/tests)
+#   test_python_example examples/python/energies.py: a scene stepped, energies plotted
+#   test_occt_*         Open CASCADE as an independent reader (tests/occt_check.cpp)
+# The install and Python tests need unsanitized code (a plain program or python3 cannot
+# load an AddressSanitizer libsem), so a SEM_SANITIZE build leaves them out; the C tests
+# cover the same library code there.
+
+if(NOT SEM_SANITIZE)
+  add_test(NAME test_install COMMAND ${CMAKE_COMMAND}
+    -DBUILD_DIR=${CMAKE_BINARY_DIR} -DSOURCE_DIR=${CMAKE_SOURCE_DIR}
+    -DPREFIX=${CMAKE_BINARY_DIR}/install-test -DLIBDIR=${CMAKE_INSTALL_LIBDIR}
+    -DSOVERSION=${SEM_SOVERSION} -DVERSION=${PROJECT_VERSION} -DC_COMPILER=${CMAKE_C_COMPILER}
+    -DPKG_CONFIG=${PKG_CONFIG_EXECUTABLE} -DPYTHON=${SEM_PYTHON_FOUND}
+    -DPYTHON_DIR=${SEM_PYTHON_INSTALL_DIR}
+    -P ${CMAKE_SOURCE_DIR}/tests/install/install_test.cmake)
+  set_tests_properties(test_install PROPERTIES TIMEOUT 300 ENVIRONMENT "OMP_NUM_THREADS=2")
+
+  if(SEM_PYTHON_FOUND)
+    set(python_env "SEM_LIBRARY=$<TARGET_FILE:sem_shared>" "PYTHONPATH=${CMAKE_SOURCE_DIR}/python"
+      "PYTHONDONTWRITEBYTECODE=1" "SEM_SHARED_MODELS=${SEM_SHARED_MODELS}"
+      "SEM_TEST_OUTPUT=${CMAKE_BINARY_DIR}/python-test-output" "SEM_SOURCE_DIR=${CMAKE_SOURCE_DIR}"
+      "OMP_NUM_THREADS=2" "MPLBACKEND=Agg")
+    add_test(NAME test_python COMMAND ${SEM_PYTHON_FOUND} -m pytest -q -p no:cacheprovider
+      ${CMAKE_SOURCE_DIR}/python/tests)
+    set_tests_properties(test_python PROPERTIES TIMEOUT 600 ENVIRONMENT "${python_env}")
+    execute_process(COMMAND ${SEM_PYTHON_FOUND} -c "import matplotlib" RESULT_VARIABLE rc
+      OUTPUT_QUIET ERROR_QUIET)
+    if(rc EQUAL 0)
+      add_test(NAME test_python_example COMMAND ${SEM_PYTHON_FOUND}
+        ${CMAKE_SOURCE_DIR}/examples/python/energies.py --frames 8
+        --out ${CMAKE_BINARY_DIR}/python-example)
+      set_tests_properties(test_python_example PROPERTIES TIMEOUT 300 ENVIRONMENT "${python_env}")
+    else()
+      message(STATUS "sem: matplotlib missing; test_python_example skipped (Debian: python3-matplotlib)")
+    endif()
+  endif()
+endif()
