@@ -30,6 +30,12 @@
  * splines 112/114, conics, offset and analytic 190-198 surfaces, ...) are skipped with a
  * warning naming them, and a trim loop that cannot be built leaves its part untrimmed with
  * a warning rather than losing the part.
+ *
+ * Boundaries given in model space only (141 type 0 without parameter-space curves, 508
+ * edges whose 504 curve has no parameter-space curve, as castle.iges writes them) are
+ * projected into the surface's (u,v) domain by closest-point inversion along each curve
+ * (geometry/trim_projection.c), so those faces are trimmed as the file means; an outer loop
+ * that turns out to be the domain's own border leaves the part untrimmed (nothing to trim).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -40,6 +46,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/trim_projection.h"
 #include "sem/model.h"
 #include "sem/nurbs.h"
 #include "sem/trim.h"
@@ -1793,9 +1800,49 @@ static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, in
     return finish_part(r, &part, idx, surf);
 }
 
-/* One 141 boundary: its parameter-space curves, reversed where SENSE = 2. */
-static sem_status boundary_loop(iges_reader *r, int idx, int depth, curve_list *l)
+/* A loop known only in model space (curves in loop order, in the surface's coordinates)
+ * projected into the part's (u,v) domain. SEM_ERR_UNSUPPORTED (with a warning naming the
+ * entity and why) when it cannot be. */
+static sem_status project_model_space_loop(iges_reader *r, int idx, const sem_part *part,
+                                           curve_list *model_space, curve_list *l, int *border)
 {
+    *border = 0;
+    if (model_space->n == 0) {
+        sem_model_warn(r->model, "entity %d (DE %d): boundary has neither parameter-space nor "
+                                 "model-space curves; that loop is left out",
+                       r->entries[idx].type, de_number(idx));
+        return SEM_ERR_UNSUPPORTED;
+    }
+    sem_surface_sampler sampler;
+    sem_error perr;
+    sem_status st = sem_surface_sampler_build(&part->surface, &sampler, &perr);
+    if (st == SEM_ERR_NOMEM) return nomem(r);
+    sem_trim_projection_settings settings = sem_default_trim_projection_settings(&part->surface);
+    sem_trim_loop loop;
+    if (st == SEM_OK)
+        st = sem_trim_project_loop(&sampler, model_space->c, model_space->n, &settings, &loop,
+                                   border, &perr);
+    sem_surface_sampler_free(&sampler);
+    if (st == SEM_ERR_NOMEM) return nomem(r);
+    if (st != SEM_OK) {
+        sem_model_warn(r->model, "entity %d (DE %d): boundary given in model space only could "
+                                 "not be projected onto its surface (%s); that loop is left out",
+                       r->entries[idx].type, de_number(idx), perr.message);
+        return SEM_ERR_UNSUPPORTED;
+    }
+    list_free(l);
+    l->n = l->cap = loop.n_curves;
+    l->c = loop.curves;
+    return SEM_OK;
+}
+
+/* One 141 boundary: its parameter-space curves, reversed where SENSE = 2; when some curve
+ * has none, the model-space curves (in the coordinates m of the surface) projected onto the
+ * part's surface instead. */
+static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int depth,
+                                const sem_part *part, curve_list *l, int *border)
+{
+    *border = 0;
     if (r->entries[idx].type != 141)
         return entity_error(r, idx, 0, "a boundary entity (141) was expected here");
     int type, n;
@@ -1829,14 +1876,22 @@ static sem_status boundary_loop(iges_reader *r, int idx, int depth, curve_list *
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    if (missing || n == 0) {
-        sem_model_warn(r->model, "entity 141 (DE %d): boundary given without parameter-space "
-                                 "curves (type %d); that loop is left out (an outer loop: the "
-                                 "part keeps its whole domain)",
-                       de_number(idx), type);
-        return SEM_ERR_UNSUPPORTED;
+    if (!missing && n > 0) return SEM_OK;
+
+    /* the model-space curves (parameter 5, 5 + 3 + K1, ...) in loop order */
+    curve_list model_space;
+    memset(&model_space, 0, sizeof model_space);
+    k = 5;
+    for (int i = 0; st == SEM_OK && i < n; ++i) {
+        int crv, kk;
+        st = param_ptr(r, idx, k, 0, &crv);
+        if (st == SEM_OK) st = param_int(r, idx, k + 2, &kk);
+        if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, &model_space);
+        k += 3 + kk;
     }
-    return SEM_OK;
+    if (st == SEM_OK) st = project_model_space_loop(r, idx, part, &model_space, l, border);
+    list_free(&model_space);
+    return st;
 }
 
 static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, int depth)
@@ -1857,11 +1912,11 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     curve_list l;
     memset(&l, 0, sizeof l);
     for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n; ++i) {
-        int b;
+        int b, border = 0;
         list_free(&l);
         st = param_ptr(r, idx, 4 + i, 0, &b);
-        if (st == SEM_OK) st = boundary_loop(r, b, depth + 1, &l);
-        if (st != SEM_OK) continue;
+        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, &l, &border);
+        if (st != SEM_OK || border) continue; /* border: the surface's own, nothing to trim */
         if (i == 0)
             set_outer(&part, &l);
         else
@@ -1875,16 +1930,37 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     return finish_part(r, &part, idx, surf);
 }
 
-/* A 508 loop: the parameter-space curves of its edges in order. SEM_ERR_UNSUPPORTED when an
- * edge has none. */
-static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
+/* Model-space curve of edge `index` (1-based) of a 504 edge list, in the coordinates m. */
+static sem_status edge_curve(iges_reader *r, int owner, int k, int list, int index,
+                             const double *m, int depth, curve_list *l)
+{
+    int n, crv;
+    sem_status st = param_int(r, list, 1, &n);
+    if (st == SEM_OK) st = need(r, list, 2, 5LL * n, "edge list (N edges)");
+    if (st != SEM_OK) return st;
+    if (index < 1 || index > n)
+        return entity_error(r, owner, token_line(r, owner, k),
+                            "edge index %d is outside edge list DE %d (%d edges)", index,
+                            de_number(list), n);
+    r->entries[list].n_used = 2 + 5 * n;
+    st = param_ptr(r, list, 2 + 5 * (index - 1), 0, &crv);
+    if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, l);
+    return st;
+}
+
+/* A 508 loop: the parameter-space curves of its edges in order into l, and (for faces
+ * whose edges lack them) the edges' model-space curves, in the coordinates m, into
+ * model_space. *missing: some edge had no parameter-space curve. */
+static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth, curve_list *l,
+                            curve_list *model_space, int *missing)
 {
     if (r->entries[idx].type != 508)
         return entity_error(r, idx, 0, "a loop entity (508) was expected here");
     int n;
     sem_status st = param_int(r, idx, 1, &n);
     if (st == SEM_OK) st = need(r, idx, 2, 5LL * n, "loop (N edges)");
-    int k = 2, missing = 0;
+    int k = 2;
+    *missing = 0;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
         int type, edge, kk;
         st = need(r, idx, k, 5, "loop edge");
@@ -1900,9 +1976,9 @@ static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
                               i + 1, de_number(edge), r->entries[edge].type, want);
             break;
         }
-        if (type != 1 && kk == 0) missing = 1;
+        if (type != 1 && kk == 0) *missing = 1;
         for (int j = 0; st == SEM_OK && j < kk; ++j) {
-            int p;
+            int p = -1;
             st = param_ptr(r, idx, k + 6 + 2 * j, 0, &p);
             if (st == SEM_OK) st = read_curves(r, p, identity_xf, depth + 1, l);
         }
@@ -1910,7 +1986,21 @@ static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    return missing ? SEM_ERR_UNSUPPORTED : SEM_OK;
+    if (!*missing) return SEM_OK;
+    /* the edges' model-space curves, in loop order (a vertex "edge", type 1, adds none: it
+     * is a collapsed edge) */
+    k = 2;
+    for (int i = 0; st == SEM_OK && i < n; ++i) {
+        int type, edge, index, kk;
+        st = param_int(r, idx, k, &type);
+        if (st == SEM_OK) st = param_ptr(r, idx, k + 1, 0, &edge);
+        if (st == SEM_OK) st = param_int(r, idx, k + 2, &index);
+        if (st == SEM_OK) st = param_int(r, idx, k + 4, &kk);
+        if (st == SEM_OK && type != 1)
+            st = edge_curve(r, idx, k + 2, edge, index, m, depth, model_space);
+        k += 5 + 2 * kk;
+    }
+    return st;
 }
 
 static sem_status emit_face(iges_reader *r, int idx, const double *parent, int depth)
@@ -1931,34 +2021,43 @@ static sem_status emit_face(iges_reader *r, int idx, const double *parent, int d
     if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
-    curve_list l;
+    curve_list l, model_space;
     memset(&l, 0, sizeof l);
-    int missing = 0;
+    memset(&model_space, 0, sizeof model_space);
+    int failed = 0;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int p;
+        int p, missing = 0, border = 0;
         list_free(&l);
+        list_free(&model_space);
         st = param_ptr(r, idx, 4 + i, 0, &p);
-        if (st == SEM_OK) st = face_loop(r, p, depth + 1, &l);
+        if (st == SEM_OK) st = face_loop(r, p, m, depth + 1, &l, &model_space, &missing);
+        if (st == SEM_OK && missing) {
+            /* no (u,v) curves for this loop: project its edges' model-space curves */
+            st = project_model_space_loop(r, p, &part, &model_space, &l, &border);
+        }
         if (st == SEM_ERR_UNSUPPORTED) {
-            missing = 1;
+            failed = 1;
             st = SEM_OK;
             continue;
         }
         if (st != SEM_OK) break;
+        if (border) continue; /* the surface's own border: nothing to trim */
         if (i == 0 && of == 1)
             set_outer(&part, &l);
         else
             st = add_hole(r, &part, &l);
     }
     list_free(&l);
+    list_free(&model_space);
     if (st != SEM_OK) {
         sem_part_free(&part);
         return st;
     }
-    if (missing) {
-        /* without every loop's (u,v) curves the face cannot be trimmed consistently */
-        sem_model_warn(r->model, "entity 510 (DE %d): face has no parameter-space trim curves; "
-                                 "kept untrimmed",
+    if (failed) {
+        /* without every loop the face cannot be trimmed consistently (the failing loop
+         * said why) */
+        sem_model_warn(r->model, "entity 510 (DE %d): a loop of the face could not be built; "
+                                 "the face is kept untrimmed",
                        de_number(idx));
         sem_part keep;
         memset(&keep, 0, sizeof keep);
