@@ -196,6 +196,30 @@ static int on_seam(const context *c, int dir, double x)
     return fabs(x - lo) <= c->eps[dir] || fabs(x - hi) <= c->eps[dir];
 }
 
+/* a and b can be consecutive points of a loop: equal in (u,v), or joined by a straight
+ * (u,v) segment whose image is a single point (a collapsed edge) */
+static int joinable(const context *c, const double a[2], const double b[2])
+{
+    const sem_surface *s = c->s;
+    double du = (b[0] - a[0]) / (s->u1 - s->u0), dv = (b[1] - a[1]) / (s->v1 - s->v0);
+    if (hypot(du, dv) < 1e-9) return 1;
+    double xa[3], x[3];
+    sem_surface_eval(s, a[0], a[1], xa, NULL, NULL, NULL);
+    for (int k = 1; k <= 8; ++k) {
+        sem_surface_eval(s, a[0] + (b[0] - a[0]) * k / 8.0, a[1] + (b[1] - a[1]) * k / 8.0, x,
+                         NULL, NULL, NULL);
+        if (dist3(x, xa) > c->tol) return 0;
+    }
+    return 1;
+}
+
+static int curve_on_seam(const context *c, int dir, const chain *ch)
+{
+    for (int i = 0; i < ch->n; ++i)
+        if (!on_seam(c, dir, ch->p[i].uv[dir])) return 0;
+    return 1;
+}
+
 /* Seam and pole fixes along the loop, curve by curve in chain order. */
 static void fix_seams_and_poles(context *c, chain *chains, int n)
 {
@@ -215,33 +239,53 @@ static void fix_seams_and_poles(context *c, chain *chains, int n)
             }
         }
         if (!c->closed[dir]) continue;
-        /* seams: the reference of a point on the seam is the nearest point off it along the
-         * loop, looking back first (within the curve, then previous curves), then forward */
-        double last_off = NAN;
-        for (int pass = 0; pass < 2; ++pass) {
-            for (int k = 0; k < n; ++k) {
-                chain *ch = &chains[k];
-                for (int i = 0; i < ch->n; ++i) {
-                    double *x = &ch->p[i].uv[dir];
-                    if (!on_seam(c, dir, *x)) {
-                        last_off = *x;
-                        continue;
-                    }
-                    double ref = NAN;
-                    /* within the curve: the nearer of the neighbours off the seam */
-                    for (int d = 1; d < ch->n && isnan(ref); ++d) {
-                        if (i - d >= 0 && !on_seam(c, dir, ch->p[i - d].uv[dir]))
-                            ref = ch->p[i - d].uv[dir];
-                        else if (i + d < ch->n && !on_seam(c, dir, ch->p[i + d].uv[dir]))
-                            ref = ch->p[i + d].uv[dir];
-                    }
-                    if (isnan(ref)) ref = last_off; /* a seam edge: the side the loop is on */
-                    if (!isnan(ref) && pass == 1) *x = ref < mid ? lo : hi;
+        /* a point on the seam in a curve that leaves it takes the side of the nearest
+         * point of that curve off the seam */
+        unsigned char *pure = calloc((size_t)n, 1);
+        if (!pure) return;
+        for (int k = 0; k < n; ++k) {
+            chain *ch = &chains[k];
+            pure[k] = (unsigned char)curve_on_seam(c, dir, ch);
+            if (pure[k]) continue;
+            for (int i = 0; i < ch->n; ++i) {
+                double *x = &ch->p[i].uv[dir];
+                if (!on_seam(c, dir, *x)) continue;
+                double ref = NAN;
+                for (int d = 1; d < ch->n && isnan(ref); ++d) {
+                    if (i - d >= 0 && !on_seam(c, dir, ch->p[i - d].uv[dir]))
+                        ref = ch->p[i - d].uv[dir];
+                    else if (i + d < ch->n && !on_seam(c, dir, ch->p[i + d].uv[dir]))
+                        ref = ch->p[i + d].uv[dir];
                 }
+                *x = ref < mid ? lo : hi;
             }
-            /* the first pass only found the last point off the seam, for a loop that
-             * starts with a seam edge */
         }
+        /* a seam edge (every point on the seam; a B-rep runs it once on each side) takes
+         * the side on which it joins both of its neighbours in (u,v); the next curve counts
+         * only once it is settled */
+        for (int k = 0; k < n; ++k) {
+            if (!pure[k]) continue;
+            chain *ch = &chains[k];
+            const chain *prev = &chains[(k + n - 1) % n], *next = &chains[(k + 1) % n];
+            int best_score = -1;
+            double best = lo;
+            for (int side = 0; side < 2; ++side) {
+                double value = side ? hi : lo;
+                double a[2] = {ch->p[0].uv[0], ch->p[0].uv[1]};
+                double b[2] = {ch->p[ch->n - 1].uv[0], ch->p[ch->n - 1].uv[1]};
+                a[dir] = b[dir] = value;
+                int score = 0;
+                if (n > 1 && !pure[(k + n - 1) % n] && joinable(c, prev->p[prev->n - 1].uv, a))
+                    score += 2;
+                if (n > 1 && !pure[(k + 1) % n] && joinable(c, b, next->p[0].uv)) score += 2;
+                /* ties: continue from the previous curve's side */
+                if (n > 1 && fabs(prev->p[prev->n - 1].uv[dir] - value) <= c->eps[dir]) score += 1;
+                if (score > best_score) best_score = score, best = value;
+            }
+            for (int i = 0; i < ch->n; ++i) ch->p[i].uv[dir] = best;
+            pure[k] = 0; /* settled */
+        }
+        free(pure);
     }
 }
 

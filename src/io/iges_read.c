@@ -893,6 +893,17 @@ static void curve_reverse(sem_curve *c)
 
 /* Inserts knot t (strictly inside the knot range) `times` times, clamped so that its
  * multiplicity stays <= degree (Piegl & Tiller A5.1, in homogeneous coordinates). */
+/* Reverses the run of curves l->c[first..] as a piece of a chain: order and direction. */
+static void reverse_curves(curve_list *l, int first)
+{
+    for (int a = first, b = l->n - 1; a < b; ++a, --b) {
+        sem_curve t = l->c[a];
+        l->c[a] = l->c[b];
+        l->c[b] = t;
+    }
+    for (int a = first; a < l->n; ++a) curve_reverse(&l->c[a]);
+}
+
 static sem_status curve_insert_knot(sem_curve *c, double t, int times)
 {
     int p = c->degree, n = c->n_ctrl;
@@ -1864,14 +1875,7 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
             st = param_ptr(r, idx, k + 3 + j, 0, &p);
             if (st == SEM_OK) st = read_curves(r, p, identity_xf, depth + 1, l);
         }
-        if (st == SEM_OK && sense == 2) {
-            for (int a = first, b = l->n - 1; a < b; ++a, --b) {
-                sem_curve t = l->c[a];
-                l->c[a] = l->c[b];
-                l->c[b] = t;
-            }
-            for (int a = first; a < l->n; ++a) curve_reverse(&l->c[a]);
-        }
+        if (st == SEM_OK && sense == 2) reverse_curves(l, first);
         k += 3 + kk;
     }
     if (st != SEM_OK) return st;
@@ -1883,10 +1887,12 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     memset(&model_space, 0, sizeof model_space);
     k = 5;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int crv, kk;
+        int crv, sense, kk, first = model_space.n;
         st = param_ptr(r, idx, k, 0, &crv);
+        if (st == SEM_OK) st = param_int(r, idx, k + 1, &sense);
         if (st == SEM_OK) st = param_int(r, idx, k + 2, &kk);
         if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, &model_space);
+        if (st == SEM_OK && sense == 2) reverse_curves(&model_space, first);
         k += 3 + kk;
     }
     if (st == SEM_OK) st = project_model_space_loop(r, idx, part, &model_space, l, border);
@@ -1991,13 +1997,18 @@ static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth,
      * is a collapsed edge) */
     k = 2;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int type, edge, index, kk;
+        int type, edge, index, forward, kk;
         st = param_int(r, idx, k, &type);
         if (st == SEM_OK) st = param_ptr(r, idx, k + 1, 0, &edge);
         if (st == SEM_OK) st = param_int(r, idx, k + 2, &index);
+        if (st == SEM_OK) st = param_int(r, idx, k + 3, &forward);
         if (st == SEM_OK) st = param_int(r, idx, k + 4, &kk);
+        int first = model_space->n;
         if (st == SEM_OK && type != 1)
             st = edge_curve(r, idx, k + 2, edge, index, m, depth, model_space);
+        /* OF = 0: the loop runs the edge backwards (this matters for closed edges, whose
+         * direction cannot be told from their ends) */
+        if (st == SEM_OK && !forward) reverse_curves(model_space, first);
         k += 5 + 2 * kk;
     }
     return st;
