@@ -73,3 +73,23 @@ def test_preprocess_box_volume_and_views():
     assert "desnity" in str(e.value)
     with pytest.raises(sem.SemError):
         m.preprocess(order=3)
+
+
+@pytest.mark.skipif(not sem.has_step(), reason="libsem built without Open CASCADE")
+def test_step_roundtrip(outdir):
+    m = sem.Model.primitive("cylinder", radius=0.5, height=2)
+    path = os.path.join(outdir, "cylinder.step")
+    m.save(path)
+    back = sem.load(path)
+    assert back.parts == m.parts and back.units == m.units
+    assert np.allclose(back.q(), m.q(), atol=1e-12)
+    area = 2 * np.pi * 0.5 * 2 + 2 * np.pi * 0.25
+    assert abs(back.measure()["area"] - area) < 1e-9 * area
+
+
+def test_step_support_is_reported():
+    assert sem.has_step() in (True, False)
+    if not sem.has_step():
+        with pytest.raises(sem.SemError) as e:
+            sem.load("x.step")
+        assert "not supported by this build" in str(e.value)

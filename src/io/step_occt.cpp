@@ -5,10 +5,13 @@
  * (src/io/step_stub.c, SEM_WITH_OCCT=OFF).
  *
  * Reading. STEPControl_Reader translates the file into a B-rep shape (solids, shells or free
- * faces, assemblies flattened with their placements). BRepBuilderAPI_NurbsConvert turns every
- * surface and every parameter-space curve into a B-spline (planes, cylinders, cones, spheres,
- * tori, extrusions and revolutions exactly; offset surfaces approximately), and each face
- * becomes one part: its surface with the face's placement applied, its outer wire as the outer
+ * faces, assemblies flattened with their placements), and each face becomes one part. A face
+ * on an analytic surface is converted by BRepBuilderAPI_NurbsConvert (planes, cylinders,
+ * cones, spheres, tori, extrusions and revolutions exactly, offset surfaces approximately;
+ * its curves on the surface follow the new parameters); a B-spline face is taken as it is,
+ * because the conversion can move a curve's end along a pole (a gap it leaves along a
+ * collapsed edge is closed by a connector, as the projection of model-space trims does).
+ * A part is: its surface with the face's placement applied, its outer wire as the outer
  * trim loop and its other wires as holes, each edge contributing its curve on the face (the
  * "pcurve"). An edge without one (a file that gives model-space edges only) gets one from
  * ShapeFix_Edge, which projects the 3D curve into the face. A reversed face has its surface
@@ -40,6 +43,7 @@
 #include <vector>
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
+#include <Bnd_Box.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepLib.hxx>
@@ -76,6 +80,7 @@
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
+#include <TopoDS_Vertex.hxx>
 #include <TopoDS_Iterator.hxx>
 #include <TopoDS_Wire.hxx>
 #include <gp_Ax2d.hxx>
@@ -114,6 +119,30 @@ public:
 private:
     Handle(Message_Messenger) messenger;
     Message_SequenceOfPrinters saved;
+};
+
+/* One Interface_Static setting changed for the duration of a call and put back after, so a
+ * program that uses Open CASCADE's translators itself keeps its own settings. */
+class static_setting {
+public:
+    static_setting(const char *name, const char *value) : name(name)
+    {
+        const char *old = Interface_Static::CVal(name);
+        had = old != nullptr;
+        if (had) saved = old;
+        Interface_Static::SetCVal(name, value);
+    }
+    ~static_setting()
+    {
+        if (had) Interface_Static::SetCVal(name, saved.c_str());
+    }
+    static_setting(const static_setting &) = delete;
+    static_setting &operator=(const static_setting &) = delete;
+
+private:
+    const char *name;
+    std::string saved;
+    bool had = false;
 };
 
 /* ---- units: STEP/Open CASCADE names <-> the model's unit name and metres ---- */
@@ -316,6 +345,49 @@ std::vector<Handle(Geom2d_BSplineCurve)> wire_curves(const TopoDS_Wire &wire, co
     return out;
 }
 
+double surface_size_occt(const Handle(Geom_BSplineSurface) & b)
+{
+    Bnd_Box box;
+    for (int j = 1; j <= b->NbVPoles(); ++j)
+        for (int i = 1; i <= b->NbUPoles(); ++i) box.Add(b->Pole(i, j));
+    double size = box.IsVoid() ? 0.0 : std::sqrt(box.SquareExtent());
+    return size > 0 && std::isfinite(size) ? size : 1.0;
+}
+
+/* Joins consecutive curves of a loop whose ends differ in (u,v) but meet in space along a
+ * collapsed edge (a pole): a straight connector, whose image is that point. Conversions can
+ * leave such gaps (NurbsConvert moves a seam edge's end along the pole of a sphere). */
+void close_collapsed_gaps(std::vector<Handle(Geom2d_BSplineCurve)> &curves,
+                          const Handle(Geom_BSplineSurface) & b, double precision)
+{
+    double u0, u1, v0, v1;
+    b->Bounds(u0, u1, v0, v1);
+    std::vector<Handle(Geom2d_BSplineCurve)> out;
+    for (size_t k = 0; k < curves.size(); ++k) {
+        out.push_back(curves[k]);
+        const Handle(Geom2d_BSplineCurve) &next = curves[(k + 1) % curves.size()];
+        gp_Pnt2d a = curves[k]->Value(curves[k]->LastParameter());
+        gp_Pnt2d c = next->Value(next->FirstParameter());
+        if (std::hypot((c.X() - a.X()) / (u1 - u0), (c.Y() - a.Y()) / (v1 - v0)) < 1e-9) continue;
+        gp_Pnt pa = b->Value(a.X(), a.Y());
+        bool collapsed = true;
+        for (int i = 1; i <= 8 && collapsed; ++i) {
+            double t = i / 8.0;
+            gp_Pnt p = b->Value(a.X() + t * (c.X() - a.X()), a.Y() + t * (c.Y() - a.Y()));
+            collapsed = p.Distance(pa) <= precision;
+        }
+        if (!collapsed) continue; /* a real gap: trim.c's closure check reports it */
+        TColgp_Array1OfPnt2d poles(1, 2);
+        poles(1) = a;
+        poles(2) = c;
+        TColStd_Array1OfReal knots(1, 2);
+        TColStd_Array1OfInteger mults(1, 2);
+        knots(1) = 0, knots(2) = 1, mults(1) = mults(2) = 2;
+        out.push_back(new Geom2d_BSplineCurve(poles, knots, mults, 1));
+    }
+    curves.swap(out);
+}
+
 sem_status part_from_face(const TopoDS_Face &face_in, int index, sem_part *part, sem_model *model,
                           sem_error *err)
 {
@@ -324,7 +396,19 @@ sem_status part_from_face(const TopoDS_Face &face_in, int index, sem_part *part,
     Handle(Geom_Surface) g = BRep_Tool::Surface(face, loc);
     if (g.IsNull()) return sem_error_set(err, SEM_ERR_INVALID, "face %d has no surface", index + 1);
     Handle(Geom_BSplineSurface) b = Handle(Geom_BSplineSurface)::DownCast(g);
-    if (b.IsNull()) b = GeomConvert::SurfaceToBSplineSurface(g);
+    if (b.IsNull()) {
+        /* an analytic or trimmed surface: convert the face, so that its curves on the
+         * surface follow the B-spline's parameters (a B-spline face is taken as it is:
+         * the conversion only approximates where it need not) */
+        BRepBuilderAPI_NurbsConvert nurbs(face, Standard_True);
+        if (nurbs.IsDone()) {
+            TopExp_Explorer ex(nurbs.Shape(), TopAbs_FACE);
+            if (ex.More()) face = TopoDS::Face(ex.Current());
+        }
+        g = BRep_Tool::Surface(face, loc);
+        b = Handle(Geom_BSplineSurface)::DownCast(g);
+        if (b.IsNull() && !g.IsNull()) b = GeomConvert::SurfaceToBSplineSurface(g);
+    }
     if (b.IsNull())
         return sem_error_set(err, SEM_ERR_UNSUPPORTED, "face %d: surface not convertible to a NURBS",
                              index + 1);
@@ -335,8 +419,13 @@ sem_status part_from_face(const TopoDS_Face &face_in, int index, sem_part *part,
     double u0, u1, v0, v1;
     b->Bounds(u0, u1, v0, v1);
     /* a reversed face: reverse the surface in u and mirror the loops with it */
+    Handle(Geom_BSplineSurface) unreversed = b;
+    double precision = 1e-6 * surface_size_occt(b);
     bool reversed = face.Orientation() == TopAbs_REVERSED;
-    if (reversed) b->UReverse();
+    if (reversed) {
+        b = Handle(Geom_BSplineSurface)::DownCast(b->Copy());
+        b->UReverse();
+    }
     gp_Ax2d mirror(gp_Pnt2d(0.5 * (u0 + u1), 0.0), gp_Dir2d(0.0, 1.0));
 
     memset(part, 0, sizeof *part);
@@ -356,6 +445,7 @@ sem_status part_from_face(const TopoDS_Face &face_in, int index, sem_part *part,
                            index + 1);
             continue;
         }
+        close_collapsed_gaps(curves, unreversed, precision);
         if (reversed)
             for (Handle(Geom2d_BSplineCurve) & c : curves) c->Mirror(mirror);
         if (w.IsSame(outer) && outer_curves.empty())
@@ -454,10 +544,30 @@ TopoDS_Wire wire_to_occt(const sem_trim_loop *loop, const Handle(Geom_BSplineSur
     Handle(ShapeExtend_WireData) data = new ShapeExtend_WireData;
     for (int k = 0; k < loop->n_curves; ++k) {
         Handle(Geom2d_BSplineCurve) c = curve_to_occt(&loop->curves[k]);
-        BRepBuilderAPI_MakeEdge me(c, surface, c->FirstParameter(), c->LastParameter());
-        if (!me.IsDone()) continue; /* a curve of zero length */
-        TopoDS_Edge e = me.Edge();
-        BRepLib::BuildCurves3d(e);
+        double f = c->FirstParameter(), l = c->LastParameter();
+        BRepBuilderAPI_MakeEdge me(c, surface, f, l);
+        if (me.IsDone()) {
+            TopoDS_Edge e = me.Edge();
+            BRepLib::BuildCurves3d(e);
+            data->Add(e);
+            continue;
+        }
+        /* a curve whose image is one point: the collapsed edge of a pole, which the loop
+         * needs in (u,v); Open CASCADE's form of it is a degenerated edge */
+        gp_Pnt a = surface->Value(c->Value(f).X(), c->Value(f).Y());
+        gp_Pnt m = surface->Value(c->Value(0.5 * (f + l)).X(), c->Value(0.5 * (f + l)).Y());
+        gp_Pnt b = surface->Value(c->Value(l).X(), c->Value(l).Y());
+        if (a.Distance(m) > precision || a.Distance(b) > precision) continue;
+        BRep_Builder builder;
+        TopoDS_Edge e;
+        builder.MakeEdge(e);
+        builder.UpdateEdge(e, c, surface, TopLoc_Location(), precision);
+        builder.Range(e, f, l);
+        builder.Degenerated(e, Standard_True);
+        TopoDS_Vertex v;
+        builder.MakeVertex(v, a, precision);
+        builder.Add(e, v.Oriented(TopAbs_FORWARD));
+        builder.Add(e, v.Oriented(TopAbs_REVERSED));
         data->Add(e);
     }
     ShapeFix_Wire fix(data->Wire(), face, precision);
@@ -513,11 +623,6 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
     if (reader.TransferRoots() <= 0 || reader.NbShapes() == 0)
         return sem_error_set(err, SEM_ERR_PARSE, "%s: no shape could be read from the file", path);
     TopoDS_Shape shape = reader.OneShape();
-    BRepBuilderAPI_NurbsConvert nurbs(shape, Standard_True);
-    if (!nurbs.IsDone())
-        return sem_error_set(err, SEM_ERR_UNSUPPORTED, "%s: the shape could not be converted to NURBS",
-                             path);
-    shape = nurbs.Shape();
 
     sem_model *m = sem_model_create();
     if (!m) return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory", path);
@@ -570,8 +675,8 @@ sem_status write_step(const sem_model *model, const char *path, sem_error *err)
     for (int i = 0; i < model->n_parts; ++i) builder.Add(compound, face_from_part(&model->parts[i]));
 
     STEPControl_Writer writer;
-    Interface_Static::SetCVal("write.step.unit", unit->occt);
-    Interface_Static::SetCVal("write.step.schema", "AP214IS");
+    static_setting unit_setting("write.step.unit", unit->occt);
+    static_setting schema_setting("write.step.schema", "AP214IS");
     writer.Model()->SetLocalLengthUnit(unit->mm); /* the shape is in the model's unit */
     writer.Model()->SetWriteLengthUnit(unit->mm);
     if (writer.Transfer(compound, STEPControl_AsIs) != IFSelect_RetDone)
