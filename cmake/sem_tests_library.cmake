@@ -51,7 +51,7 @@ if(SEM_WITH_OCCT)
     target_include_directories(occt_check SYSTEM PRIVATE ${OCCT_INCLUDE_DIR})
     target_link_libraries(occt_check PRIVATE semlib ${OCCT_TKIGES_LIB} ${OCCT_TKPRIM_LIB}
       ${OCCT_TKBO_LIB} ${SEM_OCCT_LIBS})
-    foreach(mode written direct step)
+    foreach(mode written direct step modelspace)
       add_test(NAME test_occt_${mode} COMMAND occt_check ${mode} ${SEM_SHARED_MODELS}
         ${CMAKE_BINARY_DIR}/occt-check-${mode})
       set_tests_properties(test_occt_${mode} PROPERTIES TIMEOUT 600 ENVIRONMENT "OMP_NUM_THREADS=2")

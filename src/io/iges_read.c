@@ -86,6 +86,11 @@ typedef struct iges_entry {
     unsigned char busy;        /* recursion guard */
 } iges_entry;
 
+typedef struct curve_list {
+    int n, cap;
+    sem_curve *c;
+} curve_list;
+
 typedef struct iges_reader {
     const char *name;
     sem_model *model;
@@ -100,12 +105,14 @@ typedef struct iges_reader {
     size_t n_tokens, cap_tokens;
     iges_entry *entries;
     int n_entries;
+    /* An unbounded plane (108 without a display size) has no extent of its own; when a
+     * trimmed entity that uses one has model-space boundary curves, it sets plane_hint, the
+     * plane comes out as a placeholder patch (plane_from_hint = 1) and the trimmed entity
+     * fits it to those curves (fit_plane_to_curves) and trims it by projecting them. */
+    int plane_hint;
+    int plane_from_hint;
 } iges_reader;
 
-typedef struct curve_list {
-    int n, cap;
-    sem_curve *c;
-} curve_list;
 
 /* ---------------------------------------------------------------- errors ---- */
 
@@ -1389,6 +1396,11 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     double o[3] = {xyz[0] - off * n[0], xyz[1] - off * n[1], xyz[2] - off * n[2]};
     if (sem_surface_alloc(&part->surface, 1, 1, 2, 2) != SEM_OK) return nomem(r);
     if (ptr < 0) {
+        if (!(size > 0) && r->plane_hint) {
+            set_bilinear(&part->surface, o, e1, e2, -1.0, 1.0, -1.0, 1.0);
+            r->plane_from_hint = 1;
+            return SEM_OK;
+        }
         if (!(size > 0)) {
             sem_surface_free(&part->surface);
             sem_model_warn(r->model, "entity 108 (DE %d): unbounded plane without a display "
@@ -1431,6 +1443,43 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     part->outer.n_curves = l.n;
     part->outer.curves = l.c;
     return SEM_OK;
+}
+
+/* The placeholder patch of an unbounded plane (read_plane with plane_hint), already in
+ * model space, refitted to the bounding box of the boundary curves' control points in the
+ * patch's own (u,v) axes: a rectangle around the face, which its projected loops trim (a
+ * rectangular face's loop is then the border and trims nothing). */
+static void fit_plane_to_curves(sem_surface *s, const curve_list *hint)
+{
+    const double *p00 = s->ctrl, *p10 = s->ctrl + 3, *p01 = s->ctrl + 6;
+    double o[3], a[3], b[3];
+    for (int d = 0; d < 3; ++d) {
+        o[d] = p00[d];
+        a[d] = (p10[d] - p00[d]) / (s->u1 - s->u0); /* x = o + (u - u0) a + (v - v0) b */
+        b[d] = (p01[d] - p00[d]) / (s->v1 - s->v0);
+    }
+    double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2], det = aa * bb - ab * ab;
+    if (!(det > 0)) return;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = 0; i < hint->n; ++i)
+        for (int j = 0; j < hint->c[i].n_ctrl; ++j) {
+            const double *p = hint->c[i].ctrl + 3 * j;
+            double q[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
+            double qa = q[0] * a[0] + q[1] * a[1] + q[2] * a[2], qb = q[0] * b[0] + q[1] * b[1] + q[2] * b[2];
+            double u = (bb * qa - ab * qb) / det, v = (aa * qb - ab * qa) / det;
+            lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u);
+            lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
+        }
+    if (!(hi[0] > lo[0]) || !(hi[1] > lo[1])) return;
+    double u0 = s->u0 + lo[0], u1 = s->u0 + hi[0], v0 = s->v0 + lo[1], v1 = s->v0 + hi[1];
+    double uv[4][2] = {{lo[0], lo[1]}, {hi[0], lo[1]}, {lo[0], hi[1]}, {hi[0], hi[1]}};
+    for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d) s->ctrl[3 * k + d] = o[d] + uv[k][0] * a[d] + uv[k][1] * b[d];
+    s->knots_u[0] = s->knots_u[1] = s->u0 = u0;
+    s->knots_u[2] = s->knots_u[3] = s->u1 = u1;
+    s->knots_v[0] = s->knots_v[1] = s->v0 = v0;
+    s->knots_v[2] = s->knots_v[3] = s->v1 = v1;
 }
 
 /* 118: the segments between C1(t) and C2(t) for equal relative parameter t. The two curves
@@ -1750,67 +1799,6 @@ static void set_outer(sem_part *part, curve_list *l)
     memset(l, 0, sizeof *l);
 }
 
-/* Parameter-space curve of a 142 into l; SEM_ERR_UNSUPPORTED (with a warning) when the
- * entity has none or it cannot be converted. */
-static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, curve_list *l)
-{
-    int p;
-    sem_status st = param_ptr(r, owner, k, 0, &p);
-    if (st != SEM_OK) return st;
-    if (r->entries[p].type != 142)
-        return entity_error(r, owner, token_line(r, owner, k),
-                            "parameter %d points to DE %d, a type-%d entity, where a curve on a "
-                            "surface (142) is expected",
-                            k, de_number(p), r->entries[p].type);
-    int bptr;
-    st = need(r, p, 1, 5, "curve on a parametric surface");
-    if (st == SEM_OK) st = param_ptr(r, p, 3, 1, &bptr);
-    if (st != SEM_OK) return st;
-    r->entries[p].n_used = 6;
-    if (bptr < 0) {
-        sem_model_warn(r->model, "entity 142 (DE %d): no parameter-space curve (BPTR = 0); the "
-                                 "loop is left out",
-                       de_number(p));
-        return SEM_ERR_UNSUPPORTED;
-    }
-    return read_curves(r, bptr, identity_xf, depth + 1, l);
-}
-
-static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, int depth)
-{
-    int surf, n1, n2;
-    sem_status st = surface_pointer(r, idx, 1, &surf);
-    if (st == SEM_OK) st = param_int(r, idx, 2, &n1);
-    if (st == SEM_OK) st = param_int(r, idx, 3, &n2);
-    if (st == SEM_OK) st = need(r, idx, 5, n2, "trimmed surface (N2 inner boundaries)");
-    if (st != SEM_OK) return st;
-    r->entries[idx].n_used = 5 + n2;
-    double m[12];
-    st = own_xform(r, idx, parent, m);
-    sem_part part;
-    memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
-    if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
-    if (st != SEM_OK) return st;
-    curve_list l;
-    memset(&l, 0, sizeof l);
-    if (n1 != 0) {
-        st = curve_on_surface(r, idx, 4, depth, &l);
-        if (st == SEM_OK) set_outer(&part, &l);
-    }
-    for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n2; ++i) {
-        list_free(&l);
-        st = curve_on_surface(r, idx, 5 + i, depth, &l);
-        if (st == SEM_OK) st = add_hole(r, &part, &l);
-    }
-    list_free(&l);
-    if (st != SEM_OK && st != SEM_ERR_UNSUPPORTED) {
-        sem_part_free(&part);
-        return st;
-    }
-    return finish_part(r, &part, idx, surf);
-}
-
 /* A loop known only in model space (curves in loop order, in the surface's coordinates)
  * projected into the part's (u,v) domain. SEM_ERR_UNSUPPORTED (with a warning naming the
  * entity and why) when it cannot be. */
@@ -1845,6 +1833,124 @@ static sem_status project_model_space_loop(iges_reader *r, int idx, const sem_pa
     l->n = l->cap = loop.n_curves;
     l->c = loop.curves;
     return SEM_OK;
+}
+
+/* The 142 at parameter k of owner, checked. */
+static sem_status curve_on_surface_entity(iges_reader *r, int owner, int k, int *p)
+{
+    sem_status st = param_ptr(r, owner, k, 0, p);
+    if (st != SEM_OK) return st;
+    if (r->entries[*p].type != 142)
+        return entity_error(r, owner, token_line(r, owner, k),
+                            "parameter %d points to DE %d, a type-%d entity, where a curve on a "
+                            "surface (142) is expected",
+                            k, de_number(*p), r->entries[*p].type);
+    st = need(r, *p, 1, 5, "curve on a parametric surface");
+    if (st == SEM_OK) r->entries[*p].n_used = 6;
+    return st;
+}
+
+/* The loop of a 142 (parameter k of owner) into l: its parameter-space curve (BPTR); or,
+ * when it has none or model_space is set (the surface is an unbounded plane fitted to the
+ * boundary, whose (u,v) the file's curves do not know), its model-space curve (CPTR, in the
+ * coordinates m) projected onto the part's surface. SEM_ERR_UNSUPPORTED (with a warning)
+ * when neither works. *border: the loop is the surface's own border. */
+static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, const double *m,
+                                   const sem_part *part, int model_space, curve_list *l,
+                                   int *border)
+{
+    *border = 0;
+    int p, bptr, cptr;
+    sem_status st = curve_on_surface_entity(r, owner, k, &p);
+    if (st == SEM_OK) st = param_ptr(r, p, 3, 1, &bptr);
+    if (st == SEM_OK) st = param_ptr(r, p, 4, 1, &cptr);
+    if (st != SEM_OK) return st;
+    if (bptr >= 0 && !model_space) return read_curves(r, bptr, identity_xf, depth + 1, l);
+    if (cptr < 0) {
+        sem_model_warn(r->model, "entity 142 (DE %d): no parameter-space curve (BPTR = 0) and no "
+                                 "model-space curve (CPTR = 0); the loop is left out",
+                       de_number(p));
+        return SEM_ERR_UNSUPPORTED;
+    }
+    curve_list c;
+    memset(&c, 0, sizeof c);
+    st = read_curves(r, cptr, m, depth + 1, &c);
+    if (st == SEM_OK) st = project_model_space_loop(r, p, part, &c, l, border);
+    list_free(&c);
+    return st;
+}
+
+/* The model-space curves (CPTR) of every 142 of a 144, for fitting an unbounded plane.
+ * Best effort: a curve that cannot be read is left out of the hint (its loop reports it). */
+static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *m, int depth,
+                         curve_list *hint)
+{
+    for (int i = n1 != 0 ? 0 : 1; i <= n2; ++i) {
+        int p, cptr;
+        if (curve_on_surface_entity(r, idx, 4 + i, &p) != SEM_OK) continue;
+        if (param_ptr(r, p, 4, 1, &cptr) != SEM_OK || cptr < 0) continue;
+        curve_list c;
+        memset(&c, 0, sizeof c);
+        if (read_curves(r, cptr, m, depth + 1, &c) == SEM_OK)
+            for (int j = 0; j < c.n; ++j)
+                if (list_push(r, hint, &c.c[j]) != SEM_OK) sem_curve_free(&c.c[j]);
+        free(c.c);
+    }
+}
+
+/* Reads the surface of a trimmed entity; an unbounded plane is fitted to the hint curves.
+ * *from_hint: it was (its loops must then come from model space). */
+static sem_status read_trimmed_surface(iges_reader *r, int surf, const double *m, int depth,
+                                       const curve_list *hint, sem_part *part, int *from_hint)
+{
+    r->plane_hint = hint->n > 0;
+    r->plane_from_hint = 0;
+    sem_status st = read_surface(r, surf, m, depth + 1, part);
+    r->plane_hint = 0;
+    *from_hint = st == SEM_OK && r->plane_from_hint;
+    if (*from_hint) fit_plane_to_curves(&part->surface, hint);
+    return st;
+}
+
+static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, int depth)
+{
+    int surf, n1, n2;
+    sem_status st = surface_pointer(r, idx, 1, &surf);
+    if (st == SEM_OK) st = param_int(r, idx, 2, &n1);
+    if (st == SEM_OK) st = param_int(r, idx, 3, &n2);
+    if (st == SEM_OK) st = need(r, idx, 5, n2, "trimmed surface (N2 inner boundaries)");
+    if (st != SEM_OK) return st;
+    r->entries[idx].n_used = 5 + n2;
+    double m[12];
+    st = own_xform(r, idx, parent, m);
+    curve_list hint;
+    memset(&hint, 0, sizeof hint);
+    if (st == SEM_OK && r->entries[surf].type == 108) trimmed_hint(r, idx, n1, n2, m, depth, &hint);
+    sem_part part;
+    memset(&part, 0, sizeof part);
+    int model_space = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &model_space);
+    list_free(&hint);
+    if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
+    if (st != SEM_OK) return st;
+    curve_list l;
+    memset(&l, 0, sizeof l);
+    int border = 0;
+    if (n1 != 0) {
+        st = curve_on_surface(r, idx, 4, depth, m, &part, model_space, &l, &border);
+        if (st == SEM_OK && !border) set_outer(&part, &l);
+    }
+    for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n2; ++i) {
+        list_free(&l);
+        st = curve_on_surface(r, idx, 5 + i, depth, m, &part, model_space, &l, &border);
+        if (st == SEM_OK && !border) st = add_hole(r, &part, &l);
+    }
+    list_free(&l);
+    if (st != SEM_OK && st != SEM_ERR_UNSUPPORTED) {
+        sem_part_free(&part);
+        return st;
+    }
+    return finish_part(r, &part, idx, surf);
 }
 
 /* One 141 boundary: its parameter-space curves, reversed where SENSE = 2; when some curve
