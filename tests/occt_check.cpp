@@ -647,17 +647,21 @@ TopoDS_Shape analytic_solids(double *exact)
     return all;
 }
 
-/* Open CASCADE writes the shape as IGES faces (144 trimmed surfaces) with model-space curves
- * only (write.surfacecurve.mode 0: every 142 has CPTR and BPTR = 0; planes are unbounded 108
- * entities); sem must trim every face by projecting those curves: no warning, the same
- * faces, the same areas as Open CASCADE's shape. */
-void check_model_space_iges(const char *label, const TopoDS_Shape &shape, const std::string &path,
-                            double *wu, double *wt)
+/* Open CASCADE writes the shape as IGES with model-space curves only
+ * (write.surfacecurve.mode 0): as faces (brep 0: 144 trimmed surfaces whose 142s have CPTR
+ * and BPTR = 0, planes as unbounded 108s) or as a B-rep (brep 1: 186/514/510/508/504 with
+ * no parameter-space curves, planes, cylinders, cones, spheres and tori as the analytic
+ * 190-198 entities). sem must trim every face by projecting those curves: no warning, the
+ * same faces, the same areas as Open CASCADE's shape. */
+void check_model_space_iges(const std::string &name, int brep, const TopoDS_Shape &shape,
+                            const std::string &path, double *wu, double *wt)
 {
+    std::string full = name + (brep ? " (model-space B-rep IGES)" : " (model-space IGES faces)");
+    const char *label = full.c_str();
     occt_faces o = faces_of(shape);
     {
         static_setting_occt curves("write.surfacecurve.mode", 0);
-        IGESControl_Writer writer("MM", 0);
+        IGESControl_Writer writer("MM", brep);
         writer.AddShape(shape);
         writer.ComputeModel();
         if (!writer.Write(path.c_str())) {
@@ -678,7 +682,9 @@ int run_model_space(const std::string &models, const std::string &out)
 {
     double wu = 0, wt = 0, exact;
     TopoDS_Shape solids = analytic_solids(&exact);
-    check_model_space_iges("analytic solids", solids, out + "/analytic_model_space.igs", &wu, &wt);
+    for (int brep = 0; brep < 2; ++brep)
+        check_model_space_iges("analytic solids", brep, solids, out + "/analytic_model_space.igs",
+                               &wu, &wt);
     const char *sample[] = {"mugs/mug_trimmed_complex.iges", "tire.iges", "cylinder.iges",
                             "chicken/chicken_simple_closed.iges", "lamppost.iges",
                             "castle/castle.iges", "beams/beam_cmp3_b.iges"};
@@ -686,7 +692,8 @@ int run_model_space(const std::string &models, const std::string &out)
         bool ok;
         TopoDS_Shape shape = occt_read_iges(models + "/" + name, &ok);
         if (!ok) continue;
-        check_model_space_iges(name, shape, out + "/model_space.igs", &wu, &wt);
+        for (int brep = 0; brep < 2; ++brep)
+            check_model_space_iges(name, brep, shape, out + "/model_space.igs", &wu, &wt);
     }
     printf("model-space-only IGES read by sem: worst area difference %.2e untrimmed, %.2e trimmed\n",
            wu, wt);

@@ -98,8 +98,10 @@ static void test_all_shared_models_load(void)
     load_tree(dir);
     CHECK(n_loaded >= 60, "only %d IGES files found under %s", n_loaded, dir);
     printf("loaded %d IGES files; slowest %.4f s (%s)\n", n_loaded, slowest, slowest_name);
-    /* generous for Debug/sanitizer builds; Release loads the largest file in < 0.01 s */
-    CHECK(slowest < 0.25, "slowest load %.3f s (%s)", slowest, slowest_name);
+    /* Release loads the largest file in < 0.01 s and castle.iges, whose 28 boundaries are
+     * projected from model space, in about 0.05 s; a sanitized build's times mean nothing */
+    if (!getenv("SEM_SANITIZED"))
+        CHECK(slowest < 0.25, "slowest load %.3f s (%s)", slowest, slowest_name);
 }
 
 /* q = 3 x control points equals the paper's Table 1 */
@@ -414,6 +416,33 @@ static void test_brep(void)
     sem_model_destroy(m);
 }
 
+/* IGES 5.3 analytic surfaces (tests/data/iges_generate.py, file_analytic): a cylinder and
+ * a sphere without a reference direction (form 0: the seam is placed at the face's seam
+ * edge), a plane with a reference direction and a hole, in a B-rep whose loops are in model
+ * space only; a whole torus on its own; an unbounded cylinder on its own (skipped with a
+ * warning). Areas against closed forms. */
+static void test_analytic_surfaces(void)
+{
+    sem_model *m = load_data("iges_analytic.igs");
+    if (!m) return;
+    CHECK(m->n_parts == 4, "parts %d", m->n_parts);
+    CHECK(m->n_warnings == 1 && has_warning(m, "entity 192 (DE 71): unbounded right circular "
+                                               "cylindrical surface outside a trimmed face"),
+          "warnings %d: %s", m->n_warnings, m->n_warnings ? m->warnings[0] : "");
+    if (m->n_parts == 4) {
+        const double expected[4] = {2 * M_PI, M_PI, 4 - M_PI / 4, 4 * M_PI * M_PI * 2 * 0.5};
+        const double tolerance[4] = {1e-4, 1e-4, 1e-4, 1e-12};
+        for (int i = 0; i < 4; ++i) {
+            sem_part_measure_result r;
+            CHECK(sem_part_measure(&m->parts[i], &r, NULL) == SEM_OK, "measure part %d", i);
+            CHECK(fabs(r.area - expected[i]) < tolerance[i] * expected[i],
+                  "part %d area %.9g, expected %.9g", i, r.area, expected[i]);
+        }
+        CHECK(m->parts[2].n_holes == 1 && !m->parts[3].has_outer, "plane hole, whole torus");
+    }
+    sem_model_destroy(m);
+}
+
 /* Trims given in model space only (tests/data/iges_generate.py, file_model_space): a
  * plate whose border trims nothing and whose circular hole does (143/141 TYPE 0), a
  * cylinder face cut by an ellipse whose loop runs along the seam both ways, and a sphere
@@ -630,6 +659,7 @@ int main(void)
     test_tabulated_cylinder();
     test_brep();
     test_model_space_trims();
+    test_analytic_surfaces();
     test_unknown_entity_warning();
     test_cad_trimmed();
     test_missing_bptr();

@@ -36,8 +36,8 @@ sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *
         bu[0] = s->u0, bu[1] = s->u1, nu = 2;
         bv[0] = s->v0, bv[1] = s->v1, nv = 2;
     }
-    /* per span: degree + 2 intervals, so that every bump of the patch has samples */
-    int per_u = s->degree_u + 2, per_v = s->degree_v + 2;
+    /* per span: 2 intervals (3 points); Newton from the nearest few finds the rest */
+    int per_u = 2, per_v = 2;
     int gu = (nu - 1) * per_u + 1, gv = (nv - 1) * per_v + 1;
     out->n = gu * gv;
     out->uv = malloc((size_t)out->n * 2 * sizeof(double));

@@ -102,7 +102,12 @@ static int is_closed(const sem_surface *s, int dir, double tol)
 static int collapsed_in(const context *c, int dir, const double uv[2])
 {
     const sem_surface *s = c->s;
-    double a[3], b[3], m[3];
+    double a[3], b[3], m[3], du[3], dv[3];
+    /* cheap test first: the iso-curve cannot be collapsed where it has a tangent */
+    sem_surface_eval(s, uv[0], uv[1], m, du, dv, NULL);
+    const double *t = dir == 0 ? du : dv;
+    double span = dir == 0 ? s->u1 - s->u0 : s->v1 - s->v0;
+    if (sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) * span > c->tol) return 0;
     if (dir == 0) {
         sem_surface_eval(s, s->u0, uv[1], a, NULL, NULL, NULL);
         sem_surface_eval(s, s->u1, uv[1], b, NULL, NULL, NULL);

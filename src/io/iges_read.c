@@ -46,6 +46,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/analytic_surfaces.h"
 #include "geometry/trim_projection.h"
 #include "sem/model.h"
 #include "sem/nurbs.h"
@@ -105,13 +106,19 @@ typedef struct iges_reader {
     size_t n_tokens, cap_tokens;
     iges_entry *entries;
     int n_entries;
-    /* An unbounded plane (108 without a display size) has no extent of its own; when a
-     * trimmed entity that uses one has model-space boundary curves, it sets plane_hint, the
-     * plane comes out as a placeholder patch (plane_from_hint = 1) and the trimmed entity
-     * fits it to those curves (fit_plane_to_curves) and trims it by projecting them. */
-    int plane_hint;
-    int plane_from_hint;
+    /* Surfaces whose extent or parameters the file does not give (an unbounded plane, 108
+     * without a display size; the analytic surfaces 190-198, unbounded or parameterized
+     * differently from our NURBS): when a trimmed entity or face that uses one has
+     * model-space boundary curves, it sets surface_hint; the surface comes out as a NURBS
+     * with from_hint = 1 and hint_fit saying how to size it to those curves (HINT_*), and
+     * its loops come from projecting them. */
+    int surface_hint;
+    int from_hint;
+    int hint_fit;
+    int hint_seam; /* the surface's seam may be turned to suit the boundary */
 } iges_reader;
+
+enum { HINT_NONE, HINT_PLANE, HINT_AXIAL };
 
 
 /* ---------------------------------------------------------------- errors ---- */
@@ -1396,9 +1403,10 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     double o[3] = {xyz[0] - off * n[0], xyz[1] - off * n[1], xyz[2] - off * n[2]};
     if (sem_surface_alloc(&part->surface, 1, 1, 2, 2) != SEM_OK) return nomem(r);
     if (ptr < 0) {
-        if (!(size > 0) && r->plane_hint) {
+        if (!(size > 0) && r->surface_hint) {
             set_bilinear(&part->surface, o, e1, e2, -1.0, 1.0, -1.0, 1.0);
-            r->plane_from_hint = 1;
+            r->from_hint = 1;
+            r->hint_fit = HINT_PLANE;
             return SEM_OK;
         }
         if (!(size > 0)) {
@@ -1443,43 +1451,6 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     part->outer.n_curves = l.n;
     part->outer.curves = l.c;
     return SEM_OK;
-}
-
-/* The placeholder patch of an unbounded plane (read_plane with plane_hint), already in
- * model space, refitted to the bounding box of the boundary curves' control points in the
- * patch's own (u,v) axes: a rectangle around the face, which its projected loops trim (a
- * rectangular face's loop is then the border and trims nothing). */
-static void fit_plane_to_curves(sem_surface *s, const curve_list *hint)
-{
-    const double *p00 = s->ctrl, *p10 = s->ctrl + 3, *p01 = s->ctrl + 6;
-    double o[3], a[3], b[3];
-    for (int d = 0; d < 3; ++d) {
-        o[d] = p00[d];
-        a[d] = (p10[d] - p00[d]) / (s->u1 - s->u0); /* x = o + (u - u0) a + (v - v0) b */
-        b[d] = (p01[d] - p00[d]) / (s->v1 - s->v0);
-    }
-    double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2], det = aa * bb - ab * ab;
-    if (!(det > 0)) return;
-    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (int i = 0; i < hint->n; ++i)
-        for (int j = 0; j < hint->c[i].n_ctrl; ++j) {
-            const double *p = hint->c[i].ctrl + 3 * j;
-            double q[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
-            double qa = q[0] * a[0] + q[1] * a[1] + q[2] * a[2], qb = q[0] * b[0] + q[1] * b[1] + q[2] * b[2];
-            double u = (bb * qa - ab * qb) / det, v = (aa * qb - ab * qa) / det;
-            lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u);
-            lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
-        }
-    if (!(hi[0] > lo[0]) || !(hi[1] > lo[1])) return;
-    double u0 = s->u0 + lo[0], u1 = s->u0 + hi[0], v0 = s->v0 + lo[1], v1 = s->v0 + hi[1];
-    double uv[4][2] = {{lo[0], lo[1]}, {hi[0], lo[1]}, {lo[0], hi[1]}, {hi[0], hi[1]}};
-    for (int k = 0; k < 4; ++k)
-        for (int d = 0; d < 3; ++d) s->ctrl[3 * k + d] = o[d] + uv[k][0] * a[d] + uv[k][1] * b[d];
-    s->knots_u[0] = s->knots_u[1] = s->u0 = u0;
-    s->knots_u[2] = s->knots_u[3] = s->u1 = u1;
-    s->knots_v[0] = s->knots_v[1] = s->v0 = v0;
-    s->knots_v[2] = s->knots_v[3] = s->v1 = v1;
 }
 
 /* 118: the segments between C1(t) and C2(t) for equal relative parameter t. The two curves
@@ -1653,6 +1624,85 @@ static sem_status read_tabulated(iges_reader *r, int idx, int depth, sem_surface
     return SEM_OK;
 }
 
+/* A point (116) or direction (123) entity's three coordinates. */
+static sem_status read_vector(iges_reader *r, int owner, int k, int want, int allow_null,
+                              double out[3], int *present)
+{
+    int p = -1;
+    *present = 0;
+    sem_status st = param_ptr(r, owner, k, allow_null, &p);
+    if (st != SEM_OK || p < 0) return st;
+    if (r->entries[p].type != want)
+        return entity_error(r, owner, token_line(r, owner, k),
+                            "parameter %d points to DE %d, a type-%d entity, where a %s (%d) is "
+                            "expected",
+                            k, de_number(p), r->entries[p].type,
+                            want == 116 ? "point" : "direction", want);
+    st = need(r, p, 1, 3, want == 116 ? "point" : "direction");
+    for (int d = 0; st == SEM_OK && d < 3; ++d) st = param_real(r, p, 1 + d, &out[d]);
+    if (st == SEM_OK) {
+        r->entries[p].n_used = 4;
+        *present = 1;
+    }
+    return st;
+}
+
+/* 190-198 (IGES 5.3 analytic surfaces) as exact NURBS (geometry/analytic_surfaces.c):
+ * plane, right circular cylinder and cone, sphere, torus. Their parameters are ours, not the
+ * file's, so their loops come from model space (from_hint); planes, cylinders and cones are
+ * unbounded and need the boundary to size them (surface_hint), spheres and tori are whole. */
+static sem_status read_analytic(iges_reader *r, int idx, sem_part *part)
+{
+    const iges_entry *e = &r->entries[idx];
+    int type = e->type, form = e->form, have, have_axis = 0, have_ref = 0;
+    double loc[3], axis[3] = {0, 0, 1}, ref[3], radius = 0, second = 0;
+    sem_status st = read_vector(r, idx, 1, 116, 0, loc, &have);
+    int k = 2;
+    if (st == SEM_OK && type != 196) {
+        st = read_vector(r, idx, 2, 123, 0, axis, &have_axis);
+        k = 3;
+    }
+    if (st == SEM_OK && type != 190) st = param_real(r, idx, k++, &radius);
+    if (st == SEM_OK && (type == 194 || type == 198)) st = param_real(r, idx, k++, &second);
+    if (st == SEM_OK && type == 196 && form == 1) st = read_vector(r, idx, k++, 123, 1, axis, &have_axis);
+    if (st == SEM_OK && form == 1) st = read_vector(r, idx, k++, 123, 1, ref, &have_ref);
+    if (st != SEM_OK) return st;
+    r->entries[idx].n_used = k;
+    if (type != 190 && !(radius > 0))
+        return entity_error(r, idx, 0, "radius must be positive (got %g)", radius);
+    if (type == 198 && !(second > 0 && second < radius))
+        return entity_error(r, idx, 0, "minor radius must be in (0, major radius) (got %g)", second);
+    if (type == 194 && !(fabs(second) < 90))
+        return entity_error(r, idx, 0, "cone semi-angle must be below 90 degrees (got %g)", second);
+    int bounded = type == 196 || type == 198;
+    if (!bounded && !r->surface_hint) {
+        const char *d = entity_description(type);
+        sem_model_warn(r->model, "entity %d (DE %d): unbounded %s outside a trimmed face, skipped",
+                       type, de_number(idx), d ? d : "surface");
+        return SEM_ERR_UNSUPPORTED;
+    }
+    sem_frame f;
+    sem_error ferr;
+    if (sem_frame_make(loc, axis, have_ref ? ref : NULL, &f, &ferr) != SEM_OK)
+        return entity_error(r, idx, 0, "axis or normal direction is zero");
+    switch (type) {
+    case 190: st = sem_analytic_plane(&part->surface, &f, 1.0, &ferr); break;
+    case 192: st = sem_analytic_cone(&part->surface, &f, radius, 0.0, 0.0, 1.0, &ferr); break;
+    case 194:
+        st = sem_analytic_cone(&part->surface, &f, radius, tan(second * M_PI / 180.0), 0.0, 1.0,
+                               &ferr);
+        break;
+    case 196: st = sem_analytic_sphere(&part->surface, &f, radius, &ferr); break;
+    default: st = sem_analytic_torus(&part->surface, &f, radius, second, &ferr); break;
+    }
+    if (st != SEM_OK) return nomem(r);
+    r->from_hint = 1;
+    r->hint_fit = type == 190 ? HINT_PLANE : (type == 192 || type == 194) ? HINT_AXIAL : HINT_NONE;
+    /* form 0 does not say where the seam is: place it by the face's boundary */
+    r->hint_seam = type != 190 && !have_ref;
+    return SEM_OK;
+}
+
 /* Any surface entity as a NURBS surface in the coordinates parent o (own transform). A
  * bounded plane also fills part->outer. */
 static sem_status read_surface(iges_reader *r, int idx, const double *parent, int depth,
@@ -1672,6 +1722,11 @@ static sem_status read_surface(iges_reader *r, int idx, const double *parent, in
     case 118: st = read_ruled(r, idx, depth, &part->surface); break;
     case 120: st = read_revolution(r, idx, depth, &part->surface); break;
     case 122: st = read_tabulated(r, idx, depth, &part->surface); break;
+    case 190:
+    case 192:
+    case 194:
+    case 196:
+    case 198: st = read_analytic(r, idx, part); break;
     default:
         st = is_surface_type(e->type) ? unsupported(r, idx, "not supported, skipped")
                                       : entity_error(r, idx, 0, "a surface was expected here");
@@ -1903,13 +1958,60 @@ static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *
 static sem_status read_trimmed_surface(iges_reader *r, int surf, const double *m, int depth,
                                        const curve_list *hint, sem_part *part, int *from_hint)
 {
-    r->plane_hint = hint->n > 0;
-    r->plane_from_hint = 0;
+    r->surface_hint = hint->n > 0;
+    r->from_hint = 0;
+    r->hint_fit = HINT_NONE;
+    r->hint_seam = 0;
     sem_status st = read_surface(r, surf, m, depth + 1, part);
-    r->plane_hint = 0;
-    *from_hint = st == SEM_OK && r->plane_from_hint;
-    if (*from_hint) fit_plane_to_curves(&part->surface, hint);
+    r->surface_hint = 0;
+    *from_hint = st == SEM_OK && r->from_hint;
+    if (*from_hint && (r->hint_fit != HINT_NONE || r->hint_seam) && hint->n > 0) {
+        size_t n = 0;
+        for (int i = 0; i < hint->n; ++i) n += (size_t)hint->c[i].n_ctrl;
+        double *points = malloc((n ? n : 1) * 3 * sizeof *points);
+        if (!points) {
+            sem_part_free(part);
+            return nomem(r);
+        }
+        size_t k = 0;
+        for (int i = 0; i < hint->n; ++i) {
+            memcpy(points + 3 * k, hint->c[i].ctrl, (size_t)hint->c[i].n_ctrl * 3 * sizeof *points);
+            k += (size_t)hint->c[i].n_ctrl;
+        }
+        if (r->hint_seam) {
+            /* the seam needs points on the curves (control points of arcs leave gaps) */
+            size_t ns = 0;
+            for (int i = 0; i < hint->n; ++i) ns += 16 * (size_t)(hint->c[i].n_ctrl + 1) + 1;
+            double *samples = malloc(ns * 3 * sizeof *samples);
+            size_t *offsets = malloc(((size_t)hint->n + 1) * sizeof *offsets);
+            if (samples && offsets) {
+                size_t k = 0;
+                for (int i = 0; i < hint->n; ++i) {
+                    const sem_curve *c = &hint->c[i];
+                    int steps = 16 * (c->n_ctrl + 1);
+                    offsets[i] = k;
+                    for (int j = 0; j <= steps; ++j)
+                        sem_curve_eval(c, c->t0 + (c->t1 - c->t0) * j / steps, samples + 3 * k++,
+                                       NULL);
+                }
+                offsets[hint->n] = k;
+                sem_surface_place_seam(&part->surface, samples, offsets, hint->n);
+            }
+            free(samples);
+            free(offsets);
+        }
+        if (r->hint_fit == HINT_PLANE) sem_surface_fit_plane_rectangle(&part->surface, points, n);
+        else if (r->hint_fit == HINT_AXIAL) sem_surface_fit_axial_range(&part->surface, points, n);
+        free(points);
+    }
     return st;
+}
+
+/* Surfaces that need their boundary to be read (see iges_reader.surface_hint). */
+static int needs_hint(const iges_reader *r, int surf)
+{
+    int t = r->entries[surf].type;
+    return t == 108 || (t >= 190 && t <= 198 && t % 2 == 0);
 }
 
 static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, int depth)
@@ -1925,7 +2027,7 @@ static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, in
     st = own_xform(r, idx, parent, m);
     curve_list hint;
     memset(&hint, 0, sizeof hint);
-    if (st == SEM_OK && r->entries[surf].type == 108) trimmed_hint(r, idx, n1, n2, m, depth, &hint);
+    if (st == SEM_OK && needs_hint(r, surf)) trimmed_hint(r, idx, n1, n2, m, depth, &hint);
     sem_part part;
     memset(&part, 0, sizeof part);
     int model_space = 0;
@@ -1957,7 +2059,7 @@ static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, in
  * has none, the model-space curves (in the coordinates m of the surface) projected onto the
  * part's surface instead. */
 static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int depth,
-                                const sem_part *part, curve_list *l, int *border)
+                                const sem_part *part, int model_space, curve_list *l, int *border)
 {
     *border = 0;
     if (r->entries[idx].type != 141)
@@ -1986,23 +2088,31 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    if (!missing && n > 0) return SEM_OK;
+    if (!missing && n > 0 && !model_space) return SEM_OK;
+    list_free(l);
 
     /* the model-space curves (parameter 5, 5 + 3 + K1, ...) in loop order */
-    curve_list model_space;
-    memset(&model_space, 0, sizeof model_space);
+    curve_list model_curves;
+    memset(&model_curves, 0, sizeof model_curves);
     k = 5;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int crv, sense, kk, first = model_space.n;
+        int crv, sense, kk, first = model_curves.n;
         st = param_ptr(r, idx, k, 0, &crv);
         if (st == SEM_OK) st = param_int(r, idx, k + 1, &sense);
         if (st == SEM_OK) st = param_int(r, idx, k + 2, &kk);
-        if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, &model_space);
-        if (st == SEM_OK && sense == 2) reverse_curves(&model_space, first);
+        if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, &model_curves);
+        if (st == SEM_OK && sense == 2) reverse_curves(&model_curves, first);
         k += 3 + kk;
     }
-    if (st == SEM_OK) st = project_model_space_loop(r, idx, part, &model_space, l, border);
-    list_free(&model_space);
+    if (st == SEM_OK && !part) {
+        /* only the curves are wanted (a hint for the surface) */
+        for (int i = 0; i < model_curves.n; ++i)
+            if (list_push(r, l, &model_curves.c[i]) != SEM_OK) sem_curve_free(&model_curves.c[i]);
+        free(model_curves.c);
+        return SEM_OK;
+    }
+    if (st == SEM_OK) st = project_model_space_loop(r, idx, part, &model_curves, l, border);
+    list_free(&model_curves);
     return st;
 }
 
@@ -2016,9 +2126,19 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     r->entries[idx].n_used = 4 + n;
     double m[12];
     st = own_xform(r, idx, parent, m);
+    /* a surface that needs its boundary to be sized: every boundary's model-space curves */
+    curve_list hint;
+    memset(&hint, 0, sizeof hint);
+    for (int i = 0; st == SEM_OK && needs_hint(r, surf) && i < n; ++i) {
+        int b, border;
+        if (param_ptr(r, idx, 4 + i, 0, &b) == SEM_OK)
+            (void)boundary_loop(r, b, m, depth + 1, NULL, 1, &hint, &border);
+    }
     sem_part part;
     memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
+    int model_space = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &model_space);
+    list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
     curve_list l;
@@ -2027,7 +2147,7 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
         int b, border = 0;
         list_free(&l);
         st = param_ptr(r, idx, 4 + i, 0, &b);
-        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, &l, &border);
+        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, model_space, &l, &border);
         if (st != SEM_OK || border) continue; /* border: the surface's own, nothing to trim */
         if (i == 0)
             set_outer(&part, &l);
@@ -2064,7 +2184,7 @@ static sem_status edge_curve(iges_reader *r, int owner, int k, int list, int ind
  * whose edges lack them) the edges' model-space curves, in the coordinates m, into
  * model_space. *missing: some edge had no parameter-space curve. */
 static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth, curve_list *l,
-                            curve_list *model_space, int *missing)
+                            curve_list *model_space, int force_model_space, int *missing)
 {
     if (r->entries[idx].type != 508)
         return entity_error(r, idx, 0, "a loop entity (508) was expected here");
@@ -2098,7 +2218,7 @@ static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth,
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    if (!*missing) return SEM_OK;
+    if (!*missing && !force_model_space) return SEM_OK;
     /* the edges' model-space curves, in loop order (a vertex "edge", type 1, adds none: it
      * is a collapsed edge) */
     k = 2;
@@ -2133,22 +2253,33 @@ static sem_status emit_face(iges_reader *r, int idx, const double *parent, int d
     r->entries[idx].n_used = 4 + n;
     double m[12];
     st = own_xform(r, idx, parent, m);
-    sem_part part;
-    memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
-    if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
-    if (st != SEM_OK) return st;
-    curve_list l, model_space;
+    curve_list l, model_space, hint;
     memset(&l, 0, sizeof l);
     memset(&model_space, 0, sizeof model_space);
+    memset(&hint, 0, sizeof hint);
+    /* a surface that needs its boundary to be sized: every loop's edges */
+    for (int i = 0; st == SEM_OK && needs_hint(r, surf) && i < n; ++i) {
+        int p, missing;
+        list_free(&l);
+        if (param_ptr(r, idx, 4 + i, 0, &p) == SEM_OK)
+            (void)face_loop(r, p, m, depth + 1, &l, &hint, 1, &missing);
+    }
+    list_free(&l);
+    sem_part part;
+    memset(&part, 0, sizeof part);
+    int from_hint = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &from_hint);
+    list_free(&hint);
+    if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
+    if (st != SEM_OK) return st;
     int failed = 0;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
         int p, missing = 0, border = 0;
         list_free(&l);
         list_free(&model_space);
         st = param_ptr(r, idx, 4 + i, 0, &p);
-        if (st == SEM_OK) st = face_loop(r, p, m, depth + 1, &l, &model_space, &missing);
-        if (st == SEM_OK && missing) {
+        if (st == SEM_OK) st = face_loop(r, p, m, depth + 1, &l, &model_space, from_hint, &missing);
+        if (st == SEM_OK && (missing || from_hint)) {
             /* no (u,v) curves for this loop: project its edges' model-space curves */
             st = project_model_space_loop(r, p, &part, &model_space, &l, &border);
         }
@@ -2276,7 +2407,12 @@ static sem_status emit_entity(iges_reader *r, int idx, const double *parent, int
     case 118:
     case 120:
     case 122:
-    case 128: {
+    case 128:
+    case 190:
+    case 192:
+    case 194:
+    case 196:
+    case 198: {
         sem_part part;
         memset(&part, 0, sizeof part);
         sem_status st = read_surface(r, idx, parent, depth, &part);

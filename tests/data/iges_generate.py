@@ -449,6 +449,80 @@ def file_model_space():
     save("iges_model_space_off.igs", build(E))
 
 
+def file_analytic():
+    """IGES 5.3 analytic surfaces (190-198) in a B-rep whose loops are in model space only
+    (as Open CASCADE's B-rep export writes them), with closed-form areas:
+    part 0: 192 form 0 cylinder (radius 1 about z), its seam edge at (0, 1): the face below
+            the ellipse z = 1 + x / 2: 2 pi (the seam is placed where the edge is)
+    part 1: 196 form 0 sphere (radius 1 around (5, 0, 0)), the cap above z = 1/2, seam
+            meridian on the -x side: pi
+    part 2: 190 form 1 plane z = 3 (refdir x): the square [-1,1]^2 with a hole of radius
+            1/2: 4 - pi / 4
+    part 3: a 198 torus (2, 0.5) on its own, whole: 4 pi^2 2 0.5
+    and a 192 cylinder on its own, unbounded: skipped with a warning."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    def point(p):
+        return add(Ent(116, [r(x) for x in p], status=sub))
+
+    def direction(d):
+        return add(Ent(123, [r(x) for x in d], form=0, status=sub))
+
+    i186 = add(None)
+    i514 = add(None)
+    faces = [add(None) for _ in range(3)]
+    cyl = add(Ent(192, [de(point((0, 0, 0))), de(direction((0, 0, 1))), "1.0"], status=sub))
+    sph = add(Ent(196, [de(point((5, 0, 0))), "1.0"], status=sub))
+    pln = add(Ent(190, [de(point((0, 0, 3))), de(direction((0, 0, 1))), de(direction((1, 0, 0)))],
+                  form=1, status=sub))
+    c30, s30 = math.sqrt(3) / 2, 0.5
+    rot = lambda x, y: (-y, x)  # circles starting at (0, 1)
+    verts = [(0, 1, 0), (0, 1, 1), (5 - c30, 0, s30), (5, 0, 1), (1, 0, 3), (-1, 0, 3),
+             (0.5, 0, 3)]
+    vl = add(Ent(502, [str(len(verts))] + [r(x) for p in verts for x in p], form=1, status=sub))
+    bottom = add(Ent(126, circle3(lambda x, y: (rot(x, y)[0], rot(x, y)[1], 0)), status=sub))
+    seam = add(Ent(110, line((0, 1, 0), (0, 1, 1)), status=sub))
+    ellipse = add(Ent(126, circle3(lambda x, y: (rot(x, y)[0], rot(x, y)[1], 1 + 0.5 * rot(x, y)[0])),
+                      status=sub))
+    latitude = add(Ent(126, circle3(lambda x, y: (5 - c30 * x, -c30 * y, s30)), status=sub))
+    meridian = add(Ent(126, nurbs_curve(2, [0, 0, 0, 1, 1, 1],
+                                        [(5 - c30, 0, s30), (5 - 0.5 / c30, 0, 1), (5, 0, 1)],
+                                        [1, c30, 1]), status=sub))
+    sq = [(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)]
+    square = [add(Ent(110, line(sq[k], sq[(k + 1) % 4]), status=sub)) for k in range(4)]
+    hole = add(Ent(100, ["3.0", "0.0", "0.0", "0.5", "0.0", "0.5", "0.0"], status=sub))
+    edges = [(bottom, 1, 1), (seam, 1, 2), (ellipse, 2, 2), (latitude, 3, 3), (meridian, 3, 4),
+             (hole, 7, 7)] + [(square[k], 1, 1) for k in range(4)]
+    ep = [str(len(edges))]
+    for crv, a, b in edges:
+        ep += [de(crv), de(vl), str(a), de(vl), str(b)]
+    el = add(Ent(504, ep, form=1, status=sub))
+
+    def loop(entries):
+        p = [str(len(entries))]
+        for index, forward in entries:
+            p += ["0", de(el), str(index), "1" if forward else "0", "0"]
+        return add(Ent(508, p, form=1, status=sub))
+
+    l_cyl = loop([(1, True), (2, True), (3, False), (2, False)])
+    l_sph = loop([(4, True), (5, True), (5, False)])
+    l_sq = loop([(7, True), (8, True), (9, True), (10, True)])
+    l_hole = loop([(6, True)])
+    E[i186] = Ent(186, [de(i514), "1", "0"])
+    E[i514] = Ent(514, ["3"] + [x for f in faces for x in (de(f), "1")], form=1, status=sub)
+    E[faces[0]] = Ent(510, [de(cyl), "1", "1", de(l_cyl)], form=1, status=sub)
+    E[faces[1]] = Ent(510, [de(sph), "1", "1", de(l_sph)], form=1, status=sub)
+    E[faces[2]] = Ent(510, [de(pln), "2", "1", de(l_sq), de(l_hole)], form=1, status=sub)
+    add(Ent(198, [de(point((0, -6, 0))), de(direction((0, 0, 1))), "2.0", "0.5"]))
+    add(Ent(192, [de(point((0, 0, 9))), de(direction((1, 0, 0))), "1.0"]))
+    save("iges_analytic.igs", build(E))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -517,4 +591,5 @@ if __name__ == "__main__":
     file_cad_trimmed()
     file_bptr0()
     file_model_space()
+    file_analytic()
     errors()
