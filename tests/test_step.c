@@ -151,6 +151,24 @@ static void test_cli(void)
     CHECK(strstr(out, "parts           14 (0 trimmed") != NULL, "inspect: %s", out);
     CHECK(strstr(out, "area            22\n") != NULL, "inspect: %s", out);
     CHECK(strlen(err) == 0, "inspect printed on stderr: %s", err);
+    /* preprocess and run take STEP models like any other */
+    snprintf(args, sizeof args, "preprocess %s --order 1 --rays 3 3 --json", stp);
+    CHECK(test_run_cli(args, out, sizeof out, err, sizeof err) == 0, "preprocess .STP: %s", err);
+    CHECK(strstr(out, "\"volume\"") != NULL, "preprocess --json: %.300s", out);
+    char scene[512], dir[512];
+    snprintf(scene, sizeof scene, "%s/scene.json", test_tmpdir());
+    snprintf(dir, sizeof dir, "%s/run", test_tmpdir());
+    FILE *f = fopen(scene, "w");
+    if (f) {
+        fprintf(f, "{\"objects\": [{\"model\": \"BEAM.STP\", \"sem\": {\"order\": 1, "
+                   "\"rays\": [3, 3]}, \"pin\": {\"box\": [[-0.01, -1, -1], [0.01, 2, 2]]}}], "
+                   "\"integrator\": {\"type\": \"linearly_implicit_euler\", \"dt\": 0.01}}\n");
+        fclose(f);
+    }
+    snprintf(args, sizeof args, "run %s --frames 1 --out %s --quiet --no-cache", scene, dir);
+    CHECK(test_run_cli(args, out, sizeof out, err, sizeof err) == 0, "run with a STEP model: %s", err);
+    snprintf(args, sizeof args, "%s/frame_0001.igs", dir);
+    CHECK(access(args, F_OK) == 0, "run wrote no frame_0001.igs");
 }
 
 static void test_errors(void)
