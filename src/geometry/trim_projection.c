@@ -5,14 +5,16 @@
  * surface starting from the previous sample's (u,v) (geometry/closest_point.c), and each
  * interval is halved while the surface point at the middle of the (u,v) chord departs from
  * the projected middle of the curve by more than the tolerance: the result is a polygon in
- * (u,v) whose image follows the curve, stored as a degree-1 B-spline (which trim.c flattens
- * to exactly its vertices). Polygons are what trim regions are made of anyway, so nothing is
- * lost against fitting a smooth curve, and nothing can overshoot.
+ * (u,v) whose image follows the curve, stored as a degree-1 B-spline (whose flattening in
+ * trim.c is this polygon again). Polygons are what trim regions are made of anyway, so
+ * nothing is lost against fitting a smooth curve, and nothing can overshoot. A curve gets at
+ * most MAX_POINTS points (trim.c flattens at most 4095 spans of a curve).
  *
  * Two places where (u,v) is not a function of the model-space point need care:
  *  - seams of closed surfaces (u0 and u1 map to the same curve): a point on the seam takes
- *    the side of its nearest neighbour off the seam along the loop, so that a B-rep's seam
- *    edge, traversed once on each side, lands once on u0 and once on u1;
+ *    the side of its nearest neighbour off the seam within its curve; a curve that lies on
+ *    the seam (a B-rep's seam edge, traversed once on each side) takes the side on which it
+ *    joins both neighbouring curves, so it lands once on u0 and once on u1;
  *  - collapsed edges (poles of a sphere-like patch, where x_u = 0 along v = v0): a pole
  *    point takes u from its neighbour on the same curve, and consecutive curves that meet at
  *    the pole with different u are joined by a straight connector along the collapsed edge
@@ -29,7 +31,7 @@
 
 #define SAMPLES_PER_SPAN_MIN 4
 #define MAX_DEPTH 18
-#define MAX_POINTS 3000 /* per curve (trim.c flattens at most 4095 spans per curve) */
+#define MAX_POINTS 3000
 
 typedef struct point {
     double t;
@@ -49,7 +51,6 @@ typedef struct context {
     int closed[2];     /* seam: S(u0, v) == S(u1, v) (u) / the same in v */
     double eps[2];     /* "on the border" in u and v */
     double worst;      /* largest distance of a curve point from the surface */
-    int overflow;
 } context;
 
 static double dist3(const double *a, const double *b)
@@ -157,8 +158,6 @@ static int refine(context *c, const sem_curve *cv, const point *a, const point *
             if (!refine(c, cv, a, &m, depth + 1, ch)) return 0;
             return refine(c, cv, &m, b, depth + 1, ch);
         }
-    } else if (ch->n >= MAX_POINTS) {
-        c->overflow = 1;
     }
     return push(ch, b);
 }
@@ -174,6 +173,7 @@ static int project_curve(context *c, const sem_curve *cv, int reverse, const dou
         nb = 2;
     }
     int per = cv->degree + 1 > SAMPLES_PER_SPAN_MIN ? cv->degree + 1 : SAMPLES_PER_SPAN_MIN;
+    if ((nb - 1) * per > MAX_POINTS) per = MAX_POINTS / (nb - 1) > 1 ? MAX_POINTS / (nb - 1) : 1;
     int total = (nb - 1) * per;
     point prev;
     for (int k = 0; k <= total; ++k) {
