@@ -5,9 +5,15 @@
 # browser test of sem view).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# libpng, libjs-three, ffmpeg: sem render (PNG, --mp4) and sem view (three.js);
+# libocct-*: STEP files and the Open CASCADE cross-checks of our IGES (optional for a build:
+# SEM_WITH_OCCT=OFF); python3-*: the Python package's tests and example
 packages=(build-essential cmake pkg-config libembree-dev libsuitesparse-dev libopenblas-dev
           liblapacke-dev libglpk-dev libcjson-dev
-          libpng-dev libjs-three ffmpeg)   # sem render (PNG, --mp4) and sem view (three.js)
+          libpng-dev libjs-three ffmpeg
+          libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
+          libocct-data-exchange-dev
+          python3 python3-numpy python3-pytest python3-matplotlib)
 with_tests=0
 [ "${1:-}" = "--test" ] && with_tests=1
 missing=()

@@ -16,10 +16,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-
-#ifndef SEM_VERSION_STRING
-#define SEM_VERSION_STRING "unknown"
-#endif
+#include "sem/version.h"
 
 typedef struct cli_command {
     const char *name;
@@ -41,13 +38,14 @@ static const cli_command commands[] = {
      "  sphere    --radius R (1)  --center X Y Z\n"
      "  cylinder  --radius R (1)  --height H (2)  --center X Y Z   (axis z, closed)\n"
      "  torus     --major R (1)  --minor r (0.25)  --center X Y Z   (axis z)\n"
-     "  -o, --output FILE   where to write (.igs/.iges, .obj)\n"},
+     "  -o, --output FILE   where to write (.igs/.iges, .obj, .step/.stp)\n"},
     {"inspect", cmd_inspect, "FILE [--json]",
      "sizes, degrees of freedom, area, bounding box and warnings of a model",
      "  --json   print one JSON object (file, parts, control_points, dofs, trimmed_parts,\n"
      "           bbox, area, units, warnings, part_details) instead of text\n"},
     {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
-     "  IN and OUT: .igs/.iges or .obj\n"},
+     "  IN and OUT: .igs/.iges (IGES 5.3), .obj (OBJ free-form), .step/.stp (STEP, through\n"
+     "  Open CASCADE; `sem --version` says when this build has no STEP support)\n"},
     {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (40 40) across --axis (x)  --points-per-interval N (2)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (16)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n"},
     {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--quiet]",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
@@ -211,7 +209,7 @@ static void print_help(FILE *f)
             "       sem --version\n"
             "\n"
             "commands:\n",
-            SEM_VERSION_STRING);
+            sem_version());
     for (int i = 0; i < n_commands; ++i)
         fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 }
@@ -270,7 +268,7 @@ int main(int argc, char **argv)
         return CLI_OK;
     }
     if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
-        printf("sem %s\n", SEM_VERSION_STRING);
+        printf("sem %s%s\n", sem_version(), sem_has_step() ? "" : " (without STEP: built without Open CASCADE)");
         return CLI_OK;
     }
     const cli_command *c = find_command(name);

@@ -2,7 +2,8 @@
  * model_io.c - sem_model_load / sem_model_save: pick the format from the file name, and
  * the atomic temporary-file-then-rename output every writer uses (io/atomic_file.h).
  *
- * Formats: .igs / .iges (any case) -> IGES 5.3, .obj -> Wavefront OBJ free-form.
+ * Formats: .igs / .iges (any case) -> IGES 5.3, .obj -> Wavefront OBJ free-form,
+ * .step / .stp -> STEP through Open CASCADE (step_occt.cpp, or step_stub.c without it).
  */
 #include "sem/model.h"
 
@@ -16,7 +17,7 @@
 
 #include "io/atomic_file.h"
 
-typedef enum model_format { FORMAT_UNKNOWN, FORMAT_IGES, FORMAT_OBJ } model_format;
+typedef enum model_format { FORMAT_UNKNOWN, FORMAT_IGES, FORMAT_OBJ, FORMAT_STEP } model_format;
 
 static const char *extension_of(const char *path)
 {
@@ -32,6 +33,7 @@ static model_format format_of(const char *path)
     if (!ext) return FORMAT_UNKNOWN;
     if (strcasecmp(ext, ".igs") == 0 || strcasecmp(ext, ".iges") == 0) return FORMAT_IGES;
     if (strcasecmp(ext, ".obj") == 0) return FORMAT_OBJ;
+    if (strcasecmp(ext, ".step") == 0 || strcasecmp(ext, ".stp") == 0) return FORMAT_STEP;
     return FORMAT_UNKNOWN;
 }
 
@@ -39,7 +41,8 @@ static sem_status unknown_format(const char *path, sem_error *err)
 {
     const char *ext = extension_of(path);
     return sem_error_set(err, SEM_ERR_UNSUPPORTED,
-                         "%s: unknown model file extension '%s' (expected .igs, .iges or .obj)",
+                         "%s: unknown model file extension '%s' (expected .igs, .iges, .obj, "
+                         ".step or .stp)",
                          path, ext ? ext : "");
 }
 
@@ -50,6 +53,7 @@ sem_status sem_model_load(const char *path, sem_model **out, sem_error *err)
     switch (format_of(path)) {
     case FORMAT_IGES: return sem_iges_read(path, out, err);
     case FORMAT_OBJ: return sem_obj_read(path, out, err);
+    case FORMAT_STEP: return sem_step_read(path, out, err);
     default: return unknown_format(path, err);
     }
 }
@@ -60,6 +64,7 @@ sem_status sem_model_save(const sem_model *model, const char *path, sem_error *e
     switch (format_of(path)) {
     case FORMAT_IGES: return sem_iges_write(model, path, err);
     case FORMAT_OBJ: return sem_obj_write(model, path, err);
+    case FORMAT_STEP: return sem_step_write(model, path, err);
     default: return unknown_format(path, err);
     }
 }

@@ -12,6 +12,7 @@
 #include "preprocess_view.h"
 #include "sem/preprocess.h"
 #include "sem/tessellate.h"
+#include "sem/version.h"
 
 struct sem_animation {
     sem_animation_def def;
