@@ -204,7 +204,8 @@ class sem_scene(Structure):
     _fields_ = [("path", c_char * 4096), ("n_objects", c_int), ("objects", c_void_p),
                 ("world", sem_world_def), ("frames", c_int), ("steps_per_frame", c_int),
                 ("output_dir", c_char * 4096), ("write_iges", c_int), ("write_obj", c_int),
-                ("write_mesh", c_int), ("write_usd", c_int), ("mesh_resolution", c_int)]
+                ("write_mesh", c_int), ("write_usd", c_int), ("write_glb", c_int),
+                ("mesh_resolution", c_int)]
 
 
 sem_scene_log_fn = CFUNCTYPE(None, c_void_p, c_int, c_char_p)
