@@ -3,7 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "physics/simulation_internal.h"
 #include "sem/material.h"
 #include "sem/preprocess.h"
 #include "sem/primitives.h"
@@ -389,10 +388,9 @@ static double *chunked_run(int chunk, size_t *n)
     od.initial_angular_velocity[0] = 2.0;
     od.initial_angular_velocity[2] = 3.0;
     od.material.youngs_modulus = 1e5;
-    sem_simulation_set_assembly_chunk(chunk);
+    wd.advanced.assembly_chunk = chunk;
     setup s;
     int ok = make_box_world(&s, 2, &wd, &od);
-    sem_simulation_set_assembly_chunk(0);
     sem_error err;
     for (int k = 0; k < 5 && ok; ++k) ok = sem_world_step(s.world, &err) == SEM_OK;
     double *q = NULL;
@@ -538,11 +536,79 @@ static void test_part_materials(void)
     CHECK_REL(m_dense, 2.0 * m_default, 1e-14);
 }
 
+/* Log callback of test_counters: counts Newton's trace lines. */
+static void count_lines(void *user, int level, const char *message)
+{
+    int *lines = user;
+    if (level == 0 && strncmp(message, "newton it ", 10) == 0) ++*lines;
+}
+
+/* The world's counters (sem_world_get_counters) and Newton's trace: the linearly implicit
+ * step factorizes once per step and runs no Newton iteration; Newton factorizes once per
+ * iteration plus once per fallback to the projected Hessian, and traces one line per
+ * iteration to the world's log; the trace changes no bit of the result. */
+static void test_counters(void)
+{
+    sem_error err;
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.81;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    wd.solver = SEM_SOLVER_SPARSE; /* the automatic choice is timed, so its bits may vary */
+    setup s;
+    if (make_box_world(&s, 2, &wd, NULL)) {
+        for (int k = 0; k < 3; ++k) CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
+        sem_world_counters c = sem_world_get_counters(s.world);
+        CHECK(c.steps == 3 && c.factorizations == 3 && c.newton_iterations == 0,
+              "linearly implicit: %ld steps, %ld factorizations, %ld Newton iterations", c.steps,
+              c.factorizations, c.newton_iterations);
+    }
+    setup_free(&s);
+    /* implicit Euler on a soft box, without and with the trace */
+    double *q[2] = {NULL, NULL};
+    size_t n = 0;
+    for (int trace = 0; trace < 2; ++trace) {
+        int lines = 0;
+        wd.integrator = SEM_IMPLICIT_EULER;
+        wd.log = count_lines;
+        wd.log_user = &lines;
+        wd.advanced.trace_newton = trace;
+        sem_object_def od = sem_default_object_def();
+        od.material.youngs_modulus = 1e5;
+        if (!make_box_world(&s, 2, &wd, &od)) {
+            setup_free(&s);
+            break;
+        }
+        long iterations = 0;
+        for (int k = 0; k < 3; ++k) {
+            CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
+            iterations += sem_world_last_iterations(s.world);
+        }
+        sem_world_counters c = sem_world_get_counters(s.world);
+        CHECK(c.steps == 3, "%ld steps", c.steps);
+        CHECK(c.newton_iterations == iterations && iterations >= 3,
+              "%ld Newton iterations counted, %ld reported by the steps", c.newton_iterations,
+              iterations);
+        CHECK(c.factorizations == c.newton_iterations + c.exact_hessian_fallbacks,
+              "%ld factorizations, %ld iterations, %ld fallbacks", c.factorizations,
+              c.newton_iterations, c.exact_hessian_fallbacks);
+        CHECK(lines == (trace ? iterations : 0), "trace %d: %d lines for %ld iterations", trace,
+              lines, iterations);
+        n = (size_t)sem_world_object_dofs(s.world, 0);
+        q[trace] = malloc(n * sizeof(double));
+        if (q[trace]) memcpy(q[trace], sem_world_object_q(s.world, 0), n * sizeof(double));
+        setup_free(&s);
+    }
+    if (q[0] && q[1]) CHECK(memcmp(q[0], q[1], n * sizeof(double)) == 0, "the trace changed the result");
+    free(q[0]);
+    free(q[1]);
+}
+
 int main(void)
 {
     test_free_fall();
     test_part_materials();
     test_assembly_chunks();
+    test_counters();
     test_driven_rotation();
     test_rayleigh_momentum();
     test_momentum_and_spin();

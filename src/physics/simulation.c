@@ -47,7 +47,6 @@
 #include <string.h>
 
 #include "linear_solver.h"
-#include "simulation_internal.h"
 
 typedef struct object {
     sem_object_def def;
@@ -132,6 +131,7 @@ struct sem_world {
     int step_index;
     double last_step_s, last_factor_s;
     int last_iterations;
+    sem_world_counters counters;
 };
 
 sem_world_def sem_default_world_def(void)
@@ -477,28 +477,8 @@ static sem_status setup_points(object *o, sem_error *err)
     return SEM_OK;
 }
 
+/* Points per assembly chunk when the world's settings give none. */
 #define DEFAULT_ASSEMBLY_CHUNK 8192
-static int assembly_chunk = DEFAULT_ASSEMBLY_CHUNK;
-
-static int exact_hessian_policy = 1;
-static long exact_hessian_fallbacks;
-
-int sem_simulation_set_exact_hessian(int on)
-{
-    int old = exact_hessian_policy;
-    exact_hessian_policy = on != 0;
-    return old;
-}
-
-long sem_simulation_exact_hessian_fallbacks(void)
-{
-    return exact_hessian_fallbacks;
-}
-
-void sem_simulation_set_assembly_chunk(int points)
-{
-    assembly_chunk = points > 0 ? points : DEFAULT_ASSEMBLY_CHUNK;
-}
 
 /* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
  * (W rows list parts in increasing order). */
@@ -533,7 +513,7 @@ static void basis_shift(int m, const double s[3], double *T)
  * N_p is computed once per point (not once per part pair), and Kz_ab = Kz_ba is symmetric.
  * The change of basis goes into Pi: pi_shared_i = T_i^T Pi_i. The constant basis function
  * has no gradient, so only rows 1..m-1 take part. */
-static sem_status setup_stiffness(object *o, sem_error *err)
+static sem_status setup_stiffness(object *o, int assembly_chunk, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
@@ -1098,7 +1078,8 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = setup_groups(o, err)) != SEM_OK) goto fail;
     if ((st = setup_pairs(o, err)) != SEM_OK) goto fail;
     if ((st = setup_points(o, err)) != SEM_OK) goto fail;
-    if ((st = setup_stiffness(o, err)) != SEM_OK) goto fail;
+    int chunk = w->def.advanced.assembly_chunk > 0 ? w->def.advanced.assembly_chunk : DEFAULT_ASSEMBLY_CHUNK;
+    if ((st = setup_stiffness(o, chunk, err)) != SEM_OK) goto fail;
     if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
     if ((st = setup_constant_csr(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
@@ -1672,8 +1653,10 @@ static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err
         for (size_t i = 0; i < n; ++i) rhs[i] -= tmp[i];
     }
     if (o->n_free > 0) {
-        if ((st = sem_linear_solver_factorize(o->solver, err)) != SEM_OK) goto done;
+        st = sem_linear_solver_factorize(o->solver, err);
         w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        w->counters.factorizations++;
+        if (st != SEM_OK) goto done;
         gather_free(o, rhs, fr);
         if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
         scatter_free(o, fr, vp);
@@ -1747,7 +1730,7 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
     } while (0)
 
     double g0norm = -1;
-    int it, full_steps = 0, exact_allowed = exact_hessian_policy;
+    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian;
     o->exact_hessian = 0;
     for (it = 0; it < w->def.newton_max_iterations; ++it) {
         /* the exact Hessian after two full steps in a row (see the file comment) */
@@ -1778,16 +1761,18 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
         fill_system(o, cM, o->gamma, 1.0, cD);
         st = sem_linear_solver_factorize(o->solver, err);
         w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        w->counters.factorizations++;
         if (st == SEM_ERR_NUMERIC && o->exact_hessian) {
             /* the exact system is not positive definite (e.g. a buckled or unstable
              * equilibrium): project, for the rest of this solve */
             o->exact_hessian = 0;
             exact_allowed = 0;
-            exact_hessian_fallbacks++;
+            w->counters.exact_hessian_fallbacks++;
             if ((st = assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
             fill_system(o, cM, o->gamma, 1.0, cD);
             st = sem_linear_solver_factorize(o->solver, err);
             w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+            w->counters.factorizations++;
         }
         if (st != SEM_OK) goto done;
         if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
@@ -1815,9 +1800,12 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
         full_steps = step == 1.0 ? full_steps + 1 : 0;
         double dmax = 0;
         for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
-        if (getenv("SEM_DEBUG_NEWTON"))
-            fprintf(stderr, "newton it %d: |g| %.6g E0 %.12g Et %.12g step %g slope %g dmax %g\n", it, gnorm, E0, Et,
-                    step, slope, dmax);
+        if (w->def.advanced.trace_newton && w->def.log) {
+            char line[256];
+            snprintf(line, sizeof line, "newton it %d: |g| %.6g E0 %.12g Et %.12g step %g slope %g dmax %g", it,
+                     gnorm, E0, Et, step, slope, dmax);
+            w->def.log(w->def.log_user, 0, line);
+        }
         free(dir);
         if (!isfinite(Et)) {
             st = sem_error_set(err, SEM_ERR_NUMERIC,
@@ -1832,6 +1820,7 @@ static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem
     }
 #undef ENERGY
     w->last_iterations = it;
+    w->counters.newton_iterations += it;
     if (!finite_vec(o->q, n)) {
         st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
         goto done;
@@ -1871,6 +1860,7 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
     }
     w->time += w->def.dt;
     w->step_index++;
+    w->counters.steps++;
     w->last_step_s = omp_get_wtime() - t0;
     return SEM_OK;
 }
@@ -1901,6 +1891,7 @@ const double *sem_world_object_velocity(const sem_world *w, int i) { return w->o
 double sem_world_last_step_seconds(const sem_world *w) { return w->last_step_s; }
 double sem_world_last_factor_seconds(const sem_world *w) { return w->last_factor_s; }
 int sem_world_last_iterations(const sem_world *w) { return w->last_iterations; }
+sem_world_counters sem_world_get_counters(const sem_world *w) { return w->counters; }
 
 const char *sem_world_solver_name(const sem_world *w, int i)
 {
