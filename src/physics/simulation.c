@@ -47,92 +47,8 @@
 #include <string.h>
 
 #include "linear_solver.h"
-
-typedef struct object {
-    sem_object_def def;
-    const sem_discretization *d;
-    int n_ctrl, n_parts, m, n_quad;
-    double *q, *v, *q0;        /* 3 n_ctrl */
-    /* per quadrature point */
-    const sem_material **point_material; /* into material / part_mats of this object */
-    sem_material *part_mats;   /* initialized copies of def->part_materials */
-    double *point_rho_vol;
-    double *entry_basis;       /* per W entry: m, w * b_k */
-    int *entry_pair_offset;    /* per point: start into point_pairs (k*k pairs) */
-    int *point_pairs;
-    /* part pairs (z-space blocks) */
-    int n_pairs;
-    int *pair_a, *pair_b;
-    int *pair_lookup;          /* n_parts^2 -> pair or -1 */
-    /* groups (one per origin) */
-    int n_groups;
-    int *group_start, *group_ctrl; /* CSR: control points of each group */
-    int *ctrl_group, *ctrl_local;
-    double **pi_dense;         /* per part: m x |group| row-major */
-    /* stiffness in one shared basis (see assemble_elastic) */
-    int ma;                    /* basis functions with a gradient: m - 1 */
-    double ref_X[3];           /* the shared basis is b(X - ref_X) */
-    double **pi_shared;        /* per part: ma x |group|, rows 1..m-1 of T_i^T Pi_i */
-    double *point_D;           /* per point: ma x 3, d b_k(X_p - ref_X) / dX_e, k = 1..m-1 */
-    int *plist_start;          /* per part pair: its points, in order; only pairs a <= b that
-                                * share a quadrature point have any (see pair_has_points) */
-    int *plist_point;
-    double *plist_w;           /* w_a w_b at that point */
-    int *plist_cursor;         /* per pair: first entry not yet summed (chunked assembly) */
-    int n_packed;              /* 3ma (3ma + 1) / 2 */
-    int chunk;                 /* points per assembly chunk */
-    double *N_chunk;           /* chunk x n_packed: vol B^T H B per point, packed upper */
-    double *Kz_packed;         /* per pair: running sum over earlier chunks */
-    /* group-pair blocks */
-    int n_gpairs;
-    int *gpair_a, *gpair_b;
-    int *gpair_lookup;         /* n_groups^2 -> gpair or -1 */
-    size_t *gpair_offset;      /* scalar block offsets (size |Ga||Gb|), n_gpairs + 1 */
-    int *part_pair_gpair;      /* per part pair */
-    int *gpair_pairs_start, *gpair_pairs; /* part pairs per group pair */
-    double *K_blocks;          /* 9 * gpair_offset[n]: entry (la, lb) of sub-block (d,d') at
-                                * 9*off + (9 la + 3d + d') |Gb| + lb; formed for group
-                                * pairs ga <= gb only (symmetry) */
-    double *M_blocks;          /* gpair_offset[n] */
-    double *E_blocks;          /* error matrix, gpair_offset[n] */
-    int *me_start, *me_col;    /* M and E_blocks as one CSR pattern over control points */
-    double *me_M, *me_E;
-    double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
-    int n_orphans;             /* control points tied to their part's polynomial (no samples) */
-    /* forces */
-    double *f_gravity;         /* 3 n_ctrl */
-    double gamma;
-    /* free dofs */
-    unsigned char *pinned;
-    int *presc_index;          /* per ctrl: prescription followed, or -1 (stays put) */
-    sem_prescribe *presc;
-    int n_presc;
-    int *free_index;           /* per ctrl: free index or -1 */
-    int n_free;
-    int *map;                  /* per block entry (9 per scalar entry): CSC position or -1 */
-    sem_linear_solver *solver;
-    /* z-space work */
-    double *z;                 /* n_parts*ma x 3: shared-basis coefficients */
-    double *grad_z;            /* n_parts*ma x 3 */
-    double *Kz;                /* n_pairs x (3ma)^2, for pairs with points (Kz_ba = Kz_ab) */
-    int nthreads;
-    int exact_hessian;         /* 1: skip the PSD projection (Newton near a minimum) */
-    double *grad_z_thread;
-    double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
-    double elastic_energy;
-    double volume, mass;
-} object;
-
-struct sem_world {
-    sem_world_def def;
-    int n_objects, cap;
-    object **objects;
-    double time;
-    int step_index;
-    double last_step_s, last_factor_s;
-    int last_iterations;
-    sem_world_counters counters;
-};
+#include "object.h"
+#include "world.h"
 
 sem_world_def sem_default_world_def(void)
 {
@@ -181,7 +97,7 @@ sem_world *sem_world_create(const sem_world_def *def, sem_error *err)
     return w;
 }
 
-static void object_destroy(object *o)
+static void object_destroy(sem_object *o)
 {
     if (!o) return;
     free(o->q);
@@ -256,12 +172,12 @@ void sem_world_destroy(sem_world *w)
 /* ---------------------------------------------------------------------------------- */
 /* setup                                                                               */
 
-static size_t gsize(const object *o, int g)
+static size_t gsize(const sem_object *o, int g)
 {
     return (size_t)(o->group_start[g + 1] - o->group_start[g]);
 }
 
-static sem_status setup_groups(object *o, sem_error *err)
+static sem_status setup_groups(sem_object *o, sem_error *err)
 {
     const sem_discretization *d = o->d;
     int ng = d->n_origins;
@@ -318,7 +234,7 @@ static sem_status setup_groups(object *o, sem_error *err)
 
 /* Part pairs from the weights at quadrature points and boundary samples; group pairs
  * from part pairs and from the error matrix. */
-static sem_status setup_pairs(object *o, sem_error *err)
+static sem_status setup_pairs(sem_object *o, sem_error *err)
 {
     const sem_discretization *d = o->d;
     int np = o->n_parts, ng = o->n_groups;
@@ -438,7 +354,7 @@ static sem_status setup_pairs(object *o, sem_error *err)
 
 /* Per-point data in z-space: w * b at X_p - Xbar_i for each weight entry (mass), and the
  * point's part pairs. */
-static sem_status setup_points(object *o, sem_error *err)
+static sem_status setup_points(sem_object *o, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
@@ -482,7 +398,7 @@ static sem_status setup_points(object *o, sem_error *err)
 
 /* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
  * (W rows list parts in increasing order). */
-static int pair_has_points(const object *o, int pr)
+static int pair_has_points(const sem_object *o, int pr)
 {
     return o->plist_start[pr + 1] > o->plist_start[pr];
 }
@@ -513,7 +429,7 @@ static void basis_shift(int m, const double s[3], double *T)
  * N_p is computed once per point (not once per part pair), and Kz_ab = Kz_ba is symmetric.
  * The change of basis goes into Pi: pi_shared_i = T_i^T Pi_i. The constant basis function
  * has no gradient, so only rows 1..m-1 take part. */
-static sem_status setup_stiffness(object *o, int assembly_chunk, sem_error *err)
+static sem_status setup_stiffness(sem_object *o, int assembly_chunk, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
@@ -593,7 +509,7 @@ static sem_status setup_stiffness(object *o, int assembly_chunk, sem_error *err)
 
 /* Adds Pi_a^T X Pi_b for a part pair into its group-pair block. X is m x m with leading
  * dimension ldx; block is |Ga| x |Gb| row-major; tmp has room for m x |Gb|. */
-static void add_projected(const object *o, int pa, int pb, const double *X, int ldx, double *block,
+static void add_projected(const sem_object *o, int pa, int pb, const double *X, int ldx, double *block,
                           double *tmp)
 {
     int m = o->m;
@@ -604,7 +520,7 @@ static void add_projected(const object *o, int pa, int pb, const double *X, int 
                 nb, 1.0, block, nb);
 }
 
-static size_t max_group(const object *o)
+static size_t max_group(const sem_object *o)
 {
     size_t mx = 1;
     for (int g = 0; g < o->n_groups; ++g)
@@ -613,7 +529,7 @@ static size_t max_group(const object *o)
 }
 
 /* Constant blocks: mass with per-point density, and the error matrix. */
-static sem_status setup_constant_blocks(object *o, sem_error *err)
+static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
 {
     int m = o->m, np = o->n_pairs;
     double *Mz = calloc((size_t)np * m * m + 1, sizeof(double));
@@ -772,7 +688,7 @@ static sem_status setup_constant_blocks(object *o, sem_error *err)
 
 /* M and E_blocks as CSR rows over control points, for products with them alone (the
  * right-hand side and the error force of every step) run in parallel by rows. */
-static sem_status setup_constant_csr(object *o, sem_error *err)
+static sem_status setup_constant_csr(sem_object *o, sem_error *err)
 {
     int nc = o->n_ctrl;
     o->me_start = calloc((size_t)nc + 1, sizeof(int));
@@ -811,7 +727,7 @@ static sem_status setup_constant_csr(object *o, sem_error *err)
 /* CSC pattern of the free system (upper triangle) and the map from block entries. The
  * system is symmetric and its blocks are formed for group pairs ga <= gb only: an entry of
  * such a block maps to its own position or to its mirror's; blocks ga > gb map nowhere. */
-static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *err)
+static sem_status setup_system(sem_object *o, const sem_world_def *wd, sem_error *err)
 {
     int nf = 3 * o->n_free;
     size_t total = o->gpair_offset[o->n_gpairs];
@@ -925,7 +841,7 @@ static sem_status setup_system(object *o, const sem_world_def *wd, sem_error *er
     return SEM_OK;
 }
 
-static const sem_material *material_of_part(const object *o, const sem_object_def *def, int part)
+static const sem_material *material_of_part(const sem_object *o, const sem_object_def *def, int part)
 {
     if (def->part_material && o->part_mats) {
         int k = def->part_material[part];
@@ -934,7 +850,7 @@ static const sem_material *material_of_part(const object *o, const sem_object_de
     return &o->def.material;
 }
 
-static void compute_gravity(object *o, const double g[3])
+static void compute_gravity(sem_object *o, const double g[3])
 {
     const sem_csr *G = &o->d->Gamma;
     double *fp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
@@ -945,7 +861,7 @@ static void compute_gravity(object *o, const double g[3])
     free(fp);
 }
 
-static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
+static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                    const double *system, sem_error *err);
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
@@ -959,7 +875,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         sem_error_set(err, SEM_ERR_INVALID, "discretization does not match the model");
         return -1;
     }
-    object *o = calloc(1, sizeof *o);
+    sem_object *o = calloc(1, sizeof *o);
     if (!o) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         return -1;
@@ -1123,7 +1039,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     }
     if (w->n_objects == w->cap) {
         int nc = w->cap ? 2 * w->cap : 4;
-        object **x = realloc(w->objects, (size_t)nc * sizeof *x);
+        sem_object **x = realloc(w->objects, (size_t)nc * sizeof *x);
         if (!x) {
             sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
             goto fail;
@@ -1145,7 +1061,7 @@ fail:
  * energies are translation invariant, but evaluated at q far from the origin their
  * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
  * slowly lose momentum conservation. Evaluating at the centred q removes that. */
-static const double *centered(object *o, const double *q)
+static const double *centered(sem_object *o, const double *q)
 {
     double mean[3] = {0, 0, 0};
     for (int c = 0; c < o->n_ctrl; ++c)
@@ -1156,11 +1072,11 @@ static const double *centered(object *o, const double *q)
     return o->qc;
 }
 
-static void blocks_multiply(const object *o, double cM, double cE, double cK, double cD,
+static void blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
                             const double *x, double *y);
 
 /* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (in grad). */
-static double error_term(object *o, const double *q, double *grad)
+static double error_term(sem_object *o, const double *q, double *grad)
 {
     const double *qc = centered(o, q);
     blocks_multiply(o, 0, o->gamma, 0, 0, qc, grad);
@@ -1214,11 +1130,11 @@ static void pair_sum(int np, const int *point, const double *w, int e0, int e1, 
     }
 }
 
-static void fill_gpair(object *o, int g, const double c[4], double *val);
+static void fill_gpair(sem_object *o, int g, const double c[4], double *val);
 
 /* system: NULL, or the coefficients (cM, cE, cK, cD) of fill_system, whose work is then
  * done group pair by group pair as each K block is formed (while it is in cache). */
-static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
+static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                    const double *system, sem_error *err)
 {
     const sem_discretization *d = o->d;
@@ -1427,7 +1343,7 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
 }
 
 /* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all dofs (block form). */
-static void blocks_multiply(const object *o, double cM, double cE, double cK, double cD,
+static void blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
                             const double *x, double *y)
 {
     if (cK == 0 && cD == 0) {
@@ -1480,7 +1396,7 @@ static void blocks_multiply(const object *o, double cM, double cE, double cK, do
 
 /* The solver's values of group pair g (ga <= gb): c[0] M + c[1] 2 M_eps + c[2] K + c[3] K0.
  * Every block entry has its own position (or none), so group pairs are independent. */
-static void fill_gpair(object *o, int g, const double c[4], double *val)
+static void fill_gpair(sem_object *o, int g, const double c[4], double *val)
 {
     if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see setup_system) */
     size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
@@ -1504,7 +1420,7 @@ static void fill_gpair(object *o, int g, const double c[4], double *val)
 }
 
 /* Fills the solver's values with cM M + cE 2 M_eps + cK K + cD K0 on free dofs. */
-static void fill_system(object *o, double cM, double cE, double cK, double cD)
+static void fill_system(sem_object *o, double cM, double cE, double cK, double cD)
 {
     double *val = sem_linear_solver_values(o->solver);
     const double c[4] = {cM, cE, cK, cD};
@@ -1515,7 +1431,7 @@ static void fill_system(object *o, double cM, double cE, double cK, double cD)
 /* ---------------------------------------------------------------------------------- */
 /* loads and prescribed motion                                                         */
 
-static void prescribed_position(const object *o, double t, int c, double out[3])
+static void prescribed_position(const sem_object *o, double t, int c, double out[3])
 {
     const double *x0 = o->q0 + 3 * c;
     if (o->presc_index[c] < 0) {
@@ -1547,7 +1463,7 @@ static void prescribed_position(const object *o, double t, int c, double out[3])
 }
 
 /* External forces at time t: gravity, region loads, point loads (through Gamma^T). */
-static void external_force(const object *o, double t, double *f)
+static void external_force(const sem_object *o, double t, double *f)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
     memcpy(f, o->f_gravity, n * sizeof(double));
@@ -1589,7 +1505,7 @@ static void external_force(const object *o, double t, double *f)
 /* ---------------------------------------------------------------------------------- */
 /* steppers                                                                            */
 
-static void gather_free(const object *o, const double *full, double *fr)
+static void gather_free(const sem_object *o, const double *full, double *fr)
 {
     for (int c = 0; c < o->n_ctrl; ++c) {
         int f = o->free_index[c];
@@ -1598,7 +1514,7 @@ static void gather_free(const object *o, const double *full, double *fr)
     }
 }
 
-static void scatter_free(const object *o, const double *fr, double *full)
+static void scatter_free(const sem_object *o, const double *fr, double *full)
 {
     for (int c = 0; c < o->n_ctrl; ++c) {
         int f = o->free_index[c];
@@ -1615,7 +1531,7 @@ static int finite_vec(const double *x, size_t n)
 }
 
 /* (M + h C + h^2 K) v+ = M v + h f(q), q+ = q + h v+ (the paper's step). */
-static sem_status step_linearly_implicit(sem_world *w, object *o, sem_error *err)
+static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error *err)
 {
     double h = w->def.dt, t1 = w->time + h;
     size_t n = 3 * (size_t)o->n_ctrl;
@@ -1679,7 +1595,7 @@ done:
 
 /* Newton on E(q) = 1/(2h^2) |q - q_pred|_M^2 + V(q) + gamma q^T M_eps q - f^T q (+ damping),
  * or, when h == 0 (statics), E(q) = V(q) + gamma q^T M_eps q - f^T q. */
-static sem_status newton_solve(sem_world *w, object *o, double h, double t1, sem_error *err)
+static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1, sem_error *err)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
     int dynamic = h > 0;
@@ -1848,7 +1764,7 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
     w->last_factor_s = 0;
     w->last_iterations = 0;
     for (int i = 0; i < w->n_objects; ++i) {
-        object *o = w->objects[i];
+        sem_object *o = w->objects[i];
         sem_status st;
         switch (w->def.integrator) {
         case SEM_LINEARLY_IMPLICIT_EULER: st = step_linearly_implicit(w, o, err); break;
@@ -1900,7 +1816,7 @@ const char *sem_world_solver_name(const sem_world *w, int i)
 
 double sem_world_object_nnz_percent(const sem_world *w, int i)
 {
-    const object *o = w->objects[i];
+    const sem_object *o = w->objects[i];
     /* full q-space pattern: group-pair blocks x 9 */
     double nnz = 9.0 * (double)o->gpair_offset[o->n_gpairs];
     double n = 3.0 * o->n_ctrl;
@@ -1909,7 +1825,7 @@ double sem_world_object_nnz_percent(const sem_world *w, int i)
 
 void sem_world_object_set_state(sem_world *w, int i, const double *q, const double *v)
 {
-    object *o = w->objects[i];
+    sem_object *o = w->objects[i];
     size_t n = 3 * (size_t)o->n_ctrl;
     if (q) memcpy(o->q, q, n * sizeof(double));
     if (v) memcpy(o->v, v, n * sizeof(double));
@@ -1917,7 +1833,7 @@ void sem_world_object_set_state(sem_world *w, int i, const double *q, const doub
 
 void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
 {
-    object *o = w->objects[i];
+    sem_object *o = w->objects[i];
     const sem_discretization *d = o->d;
     memset(s, 0, sizeof *s);
     s->volume = o->volume;
