@@ -47,6 +47,7 @@
 #include <string.h>
 
 #include "linear_solver.h"
+#include "loads.h"
 #include "object.h"
 #include "world.h"
 
@@ -850,17 +851,6 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
     return &o->def.material;
 }
 
-static void compute_gravity(sem_object *o, const double g[3])
-{
-    const sem_csr *G = &o->d->Gamma;
-    double *fp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
-    if (!fp) return;
-    for (int p = 0; p < o->n_quad; ++p)
-        for (int k = 0; k < 3; ++k) fp[3 * p + k] = o->point_rho_vol[p] * g[k];
-    sem_csr_multiply_transpose(G, fp, 3, o->f_gravity);
-    free(fp);
-}
-
 static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                    const double *system, sem_error *err);
 
@@ -889,22 +879,6 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->def.region_loads = NULL;
     o->def.n_point_loads = 0;
     o->def.n_region_loads = 0;
-    if (def->n_point_loads > 0) {
-        sem_point_load *pl = malloc((size_t)def->n_point_loads * sizeof *pl);
-        if (pl) {
-            memcpy(pl, def->point_loads, (size_t)def->n_point_loads * sizeof *pl);
-            o->def.point_loads = pl;
-            o->def.n_point_loads = def->n_point_loads;
-        }
-    }
-    if (def->n_region_loads > 0) {
-        sem_region_load *rl = malloc((size_t)def->n_region_loads * sizeof *rl);
-        if (rl) {
-            memcpy(rl, def->region_loads, (size_t)def->n_region_loads * sizeof *rl);
-            o->def.region_loads = rl;
-            o->def.n_region_loads = def->n_region_loads;
-        }
-    }
     o->d = d;
     o->n_ctrl = d->n_ctrl;
     o->n_parts = d->n_parts;
@@ -918,12 +892,11 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->f_gravity = calloc(nq, sizeof(double));
     o->point_material = malloc(((size_t)o->n_quad + 1) * sizeof(*o->point_material));
     o->point_rho_vol = malloc(((size_t)o->n_quad + 1) * sizeof(double));
-    o->pinned = calloc((size_t)o->n_ctrl, 1);
     o->free_index = malloc((size_t)o->n_ctrl * sizeof(int));
     o->z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
     o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double)); /* room for ma rows */
     if (!o->q || !o->v || !o->q0 || !o->f_gravity || !o->point_material || !o->point_rho_vol ||
-        !o->pinned || !o->free_index || !o->z || !o->grad_z) {
+        !o->free_index || !o->z || !o->grad_z) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -961,32 +934,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     }
     o->def.part_material = NULL; /* the caller's arrays: read above, not kept */
     o->def.part_materials = NULL;
-    if (def->pinned) memcpy(o->pinned, def->pinned, (size_t)o->n_ctrl);
-    o->presc_index = malloc((size_t)o->n_ctrl * sizeof(int));
-    o->n_presc = def->prescribe_group ? def->n_prescribes : 1;
-    o->presc = calloc((size_t)(o->n_presc > 0 ? o->n_presc : 1), sizeof(sem_prescribe));
-    if (!o->presc_index || !o->presc) {
-        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if (def->prescribe_group) {
-        if (def->n_prescribes > 0) memcpy(o->presc, def->prescribes, (size_t)def->n_prescribes * sizeof(sem_prescribe));
-        for (int c = 0; c < o->n_ctrl; ++c) {
-            int g = def->prescribe_group[c];
-            if (g >= def->n_prescribes) {
-                sem_error_set(err, SEM_ERR_INVALID, "control point %d: prescribed group %d does not exist", c, g);
-                goto fail;
-            }
-            o->presc_index[c] = g >= 0 ? g : -1;
-            if (g >= 0) o->pinned[c] = 1;
-        }
-    } else {
-        o->presc[0] = def->prescribe;
-        if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned)
-            memset(o->pinned, 1, (size_t)o->n_ctrl); /* prescribe all control points */
-        for (int c = 0; c < o->n_ctrl; ++c)
-            o->presc_index[c] = def->prescribe.type != SEM_PRESCRIBE_NONE && o->pinned[c] ? 0 : -1;
-    }
+    if ((st = sem_loads_init(o, def, err)) != SEM_OK) goto fail;
     o->n_free = 0;
     for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
     /* error stiffness: the discretization's default is for its E; rescale to ours */
@@ -1005,7 +953,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    compute_gravity(o, w->def.gravity);
+    if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
     if (o->n_free > 0 && (st = setup_system(o, &w->def, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
     if ((st = assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
@@ -1429,80 +1377,6 @@ static void fill_system(sem_object *o, double cM, double cE, double cK, double c
 }
 
 /* ---------------------------------------------------------------------------------- */
-/* loads and prescribed motion                                                         */
-
-static void prescribed_position(const sem_object *o, double t, int c, double out[3])
-{
-    const double *x0 = o->q0 + 3 * c;
-    if (o->presc_index[c] < 0) {
-        memcpy(out, o->q + 3 * c, 3 * sizeof(double));
-        return;
-    }
-    const sem_prescribe *pr = &o->presc[o->presc_index[c]];
-    if (pr->type == SEM_PRESCRIBE_AFFINE) {
-        const double *A = pr->affine;
-        for (int r = 0; r < 3; ++r) out[r] = A[4 * r] * x0[0] + A[4 * r + 1] * x0[1] + A[4 * r + 2] * x0[2] + A[4 * r + 3];
-        return;
-    }
-    if (pr->type == SEM_PRESCRIBE_ROTATE) {
-        double tt = pr->duration > 0 && t > pr->duration ? pr->duration : t;
-        double ang = pr->rate * tt;
-        double k[3] = {pr->axis_direction[0], pr->axis_direction[1], pr->axis_direction[2]};
-        double kn = sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
-        if (kn > 0)
-            for (int i = 0; i < 3; ++i) k[i] /= kn;
-        double r[3] = {x0[0] - pr->axis_point[0], x0[1] - pr->axis_point[1], x0[2] - pr->axis_point[2]};
-        double cs = cos(ang), sn = sin(ang);
-        double kxr[3] = {k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]};
-        double kdr = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
-        for (int i = 0; i < 3; ++i)
-            out[i] = pr->axis_point[i] + r[i] * cs + kxr[i] * sn + k[i] * kdr * (1 - cs);
-        return;
-    }
-    memcpy(out, o->q + 3 * c, 3 * sizeof(double));
-}
-
-/* External forces at time t: gravity, region loads, point loads (through Gamma^T). */
-static void external_force(const sem_object *o, double t, double *f)
-{
-    size_t n = 3 * (size_t)o->n_ctrl;
-    memcpy(f, o->f_gravity, n * sizeof(double));
-    const sem_discretization *d = o->d;
-    for (int l = 0; l < o->def.n_region_loads; ++l) {
-        const sem_region_load *rl = &o->def.region_loads[l];
-        double s = rl->frequency > 0 ? 0.5 * (1 + sin(2 * M_PI * rl->frequency * t + rl->phase)) : 1.0;
-        for (int p = 0; p < o->n_quad; ++p) {
-            const double *X = d->quad_X + 3 * p;
-            if (X[0] < rl->box[0] || X[1] < rl->box[1] || X[2] < rl->box[2] || X[0] > rl->box[3] ||
-                X[1] > rl->box[4] || X[2] > rl->box[5])
-                continue;
-            double vol = d->quad_volume[p];
-            for (int e = d->Gamma.row_start[p]; e < d->Gamma.row_start[p + 1]; ++e)
-                for (int k = 0; k < 3; ++k)
-                    f[3 * (size_t)d->Gamma.col[e] + k] += d->Gamma.val[e] * vol * s * rl->force_density[k];
-        }
-    }
-    for (int l = 0; l < o->def.n_point_loads; ++l) {
-        /* the force acts at the quadrature point nearest its rest position */
-        const sem_point_load *pl = &o->def.point_loads[l];
-        int best = -1;
-        double bd = INFINITY;
-        for (int p = 0; p < o->n_quad; ++p) {
-            const double *X = d->quad_X + 3 * p;
-            double dd = (X[0] - pl->X[0]) * (X[0] - pl->X[0]) + (X[1] - pl->X[1]) * (X[1] - pl->X[1]) +
-                        (X[2] - pl->X[2]) * (X[2] - pl->X[2]);
-            if (dd < bd) {
-                bd = dd;
-                best = p;
-            }
-        }
-        if (best < 0) continue;
-        for (int e = d->Gamma.row_start[best]; e < d->Gamma.row_start[best + 1]; ++e)
-            for (int k = 0; k < 3; ++k) f[3 * (size_t)d->Gamma.col[e] + k] += d->Gamma.val[e] * pl->force[k];
-    }
-}
-
-/* ---------------------------------------------------------------------------------- */
 /* steppers                                                                            */
 
 static void gather_free(const sem_object *o, const double *full, double *fr)
@@ -1548,7 +1422,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
     /* the system matrix's values are written as its K blocks are formed */
     const double coef[4] = {1.0 + h * a, h * h * o->gamma, h * h, h * b};
     if ((st = assemble_elastic(o, o->q, 1, g, o->n_free > 0 ? coef : NULL, err)) != SEM_OK) goto done;
-    external_force(o, w->time, f);
+    sem_external_force(o, w->time, f);
     /* f_total = f_ext - grad V - 2 gamma M_eps q */
     error_term(o, o->q, tmp);
     for (size_t i = 0; i < n; ++i) f[i] -= g[i] + tmp[i];
@@ -1560,7 +1434,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
     for (int c = 0; c < o->n_ctrl; ++c) {
         if (!o->pinned[c]) continue;
         double x1[3];
-        prescribed_position(o, t1, c, x1);
+        sem_prescribed_position(o, t1, c, x1);
         for (int k = 0; k < 3; ++k) vp[3 * c + k] = (x1[k] - o->q[3 * c + k]) / h;
         any_pinned = 1;
     }
@@ -1613,10 +1487,10 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
     }
     memcpy(qn, o->q, n * sizeof(double));
     for (size_t i = 0; i < n; ++i) qpred[i] = o->q[i] + (dynamic ? h * o->v[i] : 0);
-    external_force(o, t1, f);
+    sem_external_force(o, t1, f);
     /* pinned points go to their prescribed positions at t1 */
     for (int c = 0; c < o->n_ctrl; ++c)
-        if (o->pinned[c]) prescribed_position(o, t1, c, o->q + 3 * c);
+        if (o->pinned[c]) sem_prescribed_position(o, t1, c, o->q + 3 * c);
     if (dynamic)
         for (int c = 0; c < o->n_ctrl; ++c)
             if (!o->pinned[c])
