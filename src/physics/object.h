@@ -1,6 +1,16 @@
 /*
  * object.h - one SEM object of a world: its state, the block structure of its matrices
- * and the data every physics file reads (internal to src/physics/).
+ * and the data the physics files share (internal to src/physics/).
+ *
+ * Block structure. Pi_i (Eq. 7) maps the control points of the parts that share part i's
+ * deformation origin - its *group* - to part i's polynomial coefficients. A quadrature
+ * point or boundary sample couples the parts with weight there, so every matrix over
+ * control points (mass M, error matrix M_eps, stiffness K) is made of dense blocks, one
+ * per *group pair* (ga, gb) of two coupled parts' groups. The blocks of an object are stored
+ * one after the other: group pair g's block is |Ga| x |Gb| scalars at gpair_offset[g] (M,
+ * M_eps: the same for each coordinate) or 9 sub-blocks (d, d'), one per coordinate pair, at
+ * 9 gpair_offset[g] (K). The layout is fixed when the object is added
+ * (object_layout.c) and every other file works through it.
  */
 #ifndef SEM_PHYSICS_OBJECT_H
 #define SEM_PHYSICS_OBJECT_H
@@ -31,7 +41,7 @@ typedef struct sem_object {
     int *group_start, *group_ctrl; /* CSR: control points of each group */
     int *ctrl_group, *ctrl_local;
     double **pi_dense;         /* per part: m x |group| row-major */
-    /* stiffness in one shared basis (see assemble_elastic) */
+    /* stiffness in one shared basis (see assembly.h) */
     int ma;                    /* basis functions with a gradient: m - 1 */
     double ref_X[3];           /* the shared basis is b(X - ref_X) */
     double **pi_shared;        /* per part: ma x |group|, rows 1..m-1 of T_i^T Pi_i */
@@ -80,9 +90,22 @@ typedef struct sem_object {
     int nthreads;
     int exact_hessian;         /* 1: skip the PSD projection (Newton near a minimum) */
     double *grad_z_thread;
-    double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
+    double *qc;                /* q minus its mean, 3 n_ctrl (see sem_centered) */
     double elastic_energy;
     double volume, mass;
 } sem_object;
+
+/* Control points in group g. */
+static inline size_t sem_group_size(const sem_object *o, int g)
+{
+    return (size_t)(o->group_start[g + 1] - o->group_start[g]);
+}
+
+/* object_layout.c: groups, part pairs (from the weights at quadrature points and boundary
+ * samples), group pairs (from part pairs and the patterns of M and M_eps), block offsets,
+ * and zeroed K, K0, M and M_eps blocks. */
+sem_status sem_object_layout_init(sem_object *o, sem_error *err);
+/* The largest group (at least 1). */
+size_t sem_max_group_size(const sem_object *o);
 
 #endif

@@ -170,189 +170,6 @@ void sem_world_destroy(sem_world *w)
     free(w);
 }
 
-/* ---------------------------------------------------------------------------------- */
-/* setup                                                                               */
-
-static size_t gsize(const sem_object *o, int g)
-{
-    return (size_t)(o->group_start[g + 1] - o->group_start[g]);
-}
-
-static sem_status setup_groups(sem_object *o, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    int ng = d->n_origins;
-    o->n_groups = ng;
-    o->group_start = calloc((size_t)ng + 1, sizeof(int));
-    o->group_ctrl = malloc((size_t)o->n_ctrl * sizeof(int));
-    o->ctrl_group = malloc((size_t)o->n_ctrl * sizeof(int));
-    o->ctrl_local = malloc((size_t)o->n_ctrl * sizeof(int));
-    if (!o->group_start || !o->group_ctrl || !o->ctrl_group || !o->ctrl_local)
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = d->part_origin[i];
-        if (g < 0 || g >= ng)
-            return sem_error_set(err, SEM_ERR_INVALID, "part %d has no valid origin", i);
-        o->group_start[g + 1] += d->part_ctrl_offset[i + 1] - d->part_ctrl_offset[i];
-    }
-    for (int g = 0; g < ng; ++g) o->group_start[g + 1] += o->group_start[g];
-    int *fill = malloc((size_t)ng * sizeof(int));
-    if (!fill) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    memcpy(fill, o->group_start, (size_t)ng * sizeof(int));
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = d->part_origin[i];
-        for (int c = d->part_ctrl_offset[i]; c < d->part_ctrl_offset[i + 1]; ++c) {
-            o->ctrl_group[c] = g;
-            o->ctrl_local[c] = fill[g] - o->group_start[g];
-            o->group_ctrl[fill[g]++] = c;
-        }
-    }
-    free(fill);
-    /* dense Pi per part over its group's control points */
-    o->pi_dense = calloc((size_t)(o->n_parts > 0 ? o->n_parts : 1), sizeof(double *));
-    if (!o->pi_dense) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    int m = o->m;
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = d->part_origin[i];
-        size_t n = gsize(o, g);
-        o->pi_dense[i] = calloc((size_t)m * n, sizeof(double));
-        if (!o->pi_dense[i]) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        for (int k = 0; k < m; ++k) {
-            int row = i * m + k;
-            for (int e = d->Pi.row_start[row]; e < d->Pi.row_start[row + 1]; ++e) {
-                int c = d->Pi.col[e];
-                if (o->ctrl_group[c] != g)
-                    return sem_error_set(err, SEM_ERR_INVALID,
-                                         "projection of part %d reaches a control point outside "
-                                         "its origin's parts",
-                                         i);
-                o->pi_dense[i][(size_t)k * n + (size_t)o->ctrl_local[c]] = d->Pi.val[e];
-            }
-        }
-    }
-    return SEM_OK;
-}
-
-/* Part pairs from the weights at quadrature points and boundary samples; group pairs
- * from part pairs and from the error matrix. */
-static sem_status setup_pairs(sem_object *o, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    int np = o->n_parts, ng = o->n_groups;
-    o->pair_lookup = malloc((size_t)np * np * sizeof(int));
-    o->gpair_lookup = malloc((size_t)ng * ng * sizeof(int));
-    if (!o->pair_lookup || !o->gpair_lookup) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (size_t k = 0; k < (size_t)np * np; ++k) o->pair_lookup[k] = -1;
-    for (size_t k = 0; k < (size_t)ng * ng; ++k) o->gpair_lookup[k] = -1;
-    int cap = 64;
-    o->pair_a = malloc((size_t)cap * sizeof(int));
-    o->pair_b = malloc((size_t)cap * sizeof(int));
-    if (!o->pair_a || !o->pair_b) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    const sem_csr *Ws[2] = {&d->W, &d->W_samples};
-    for (int w = 0; w < 2; ++w) {
-        const sem_csr *W = Ws[w];
-        for (int p = 0; p < W->n_rows; ++p)
-            for (int a = W->row_start[p]; a < W->row_start[p + 1]; ++a)
-                for (int b = W->row_start[p]; b < W->row_start[p + 1]; ++b) {
-                    int i = W->col[a], j = W->col[b];
-                    if (o->pair_lookup[(size_t)i * np + j] >= 0) continue;
-                    if (o->n_pairs == cap) {
-                        cap *= 2;
-                        int *x = realloc(o->pair_a, (size_t)cap * sizeof(int));
-                        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-                        o->pair_a = x;
-                        x = realloc(o->pair_b, (size_t)cap * sizeof(int));
-                        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-                        o->pair_b = x;
-                    }
-                    o->pair_lookup[(size_t)i * np + j] = o->n_pairs;
-                    o->pair_a[o->n_pairs] = i;
-                    o->pair_b[o->n_pairs] = j;
-                    o->n_pairs++;
-                }
-    }
-    /* group pairs: from part pairs, and from the error matrix's pattern */
-    o->part_pair_gpair = malloc((size_t)o->n_pairs * sizeof(int));
-    int gcap = 64;
-    o->gpair_a = malloc((size_t)gcap * sizeof(int));
-    o->gpair_b = malloc((size_t)gcap * sizeof(int));
-    if (!o->part_pair_gpair || !o->gpair_a || !o->gpair_b)
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-#define ADD_GPAIR(ga, gb)                                                                   \
-    do {                                                                                    \
-        size_t key_ = (size_t)(ga) * ng + (size_t)(gb);                                     \
-        if (o->gpair_lookup[key_] < 0) {                                                    \
-            if (o->n_gpairs == gcap) {                                                      \
-                gcap *= 2;                                                                  \
-                int *x_ = realloc(o->gpair_a, (size_t)gcap * sizeof(int));                  \
-                if (!x_) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");         \
-                o->gpair_a = x_;                                                            \
-                x_ = realloc(o->gpair_b, (size_t)gcap * sizeof(int));                       \
-                if (!x_) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");         \
-                o->gpair_b = x_;                                                            \
-            }                                                                               \
-            o->gpair_lookup[key_] = o->n_gpairs;                                            \
-            o->gpair_a[o->n_gpairs] = (ga);                                                 \
-            o->gpair_b[o->n_gpairs] = (gb);                                                 \
-            o->n_gpairs++;                                                                  \
-        }                                                                                   \
-    } while (0)
-    for (int k = 0; k < o->n_pairs; ++k) {
-        int ga = d->part_origin[o->pair_a[k]], gb = d->part_origin[o->pair_b[k]];
-        ADD_GPAIR(ga, gb);
-        o->part_pair_gpair[k] = o->gpair_lookup[(size_t)ga * ng + gb];
-    }
-    for (int r = 0; r < d->M_eps.n_rows; ++r)
-        for (int e = d->M_eps.row_start[r]; e < d->M_eps.row_start[r + 1]; ++e) {
-            int ga = o->ctrl_group[r], gb = o->ctrl_group[d->M_eps.col[e]];
-            ADD_GPAIR(ga, gb);
-        }
-    for (int r = 0; r < d->M.n_rows; ++r)
-        for (int e = d->M.row_start[r]; e < d->M.row_start[r + 1]; ++e) {
-            int ga = o->ctrl_group[r], gb = o->ctrl_group[d->M.col[e]];
-            ADD_GPAIR(ga, gb);
-        }
-#undef ADD_GPAIR
-    o->gpair_offset = malloc(((size_t)o->n_gpairs + 1) * sizeof(size_t));
-    if (!o->gpair_offset) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    o->gpair_offset[0] = 0;
-    for (int k = 0; k < o->n_gpairs; ++k)
-        o->gpair_offset[k + 1] = o->gpair_offset[k] + gsize(o, o->gpair_a[k]) * gsize(o, o->gpair_b[k]);
-    /* part pairs per group pair (for a parallel, race-free Pi^T Kz Pi) */
-    o->gpair_pairs_start = calloc((size_t)o->n_gpairs + 1, sizeof(int));
-    o->gpair_pairs = malloc(((size_t)o->n_pairs + 1) * sizeof(int));
-    if (!o->gpair_pairs_start || !o->gpair_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int k = 0; k < o->n_pairs; ++k) o->gpair_pairs_start[o->part_pair_gpair[k] + 1]++;
-    for (int g = 0; g < o->n_gpairs; ++g) o->gpair_pairs_start[g + 1] += o->gpair_pairs_start[g];
-    int *fill = malloc(((size_t)o->n_gpairs + 1) * sizeof(int));
-    if (!fill) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    memcpy(fill, o->gpair_pairs_start, (size_t)o->n_gpairs * sizeof(int));
-    for (int k = 0; k < o->n_pairs; ++k) o->gpair_pairs[fill[o->part_pair_gpair[k]]++] = k;
-    free(fill);
-    /* within a group pair, pairs with the same first part are consecutive (see the
-     * projection in assemble_elastic) */
-    for (int g = 0; g < o->n_gpairs; ++g) {
-        int a = o->gpair_pairs_start[g], b = o->gpair_pairs_start[g + 1];
-        for (int k = a + 1; k < b; ++k) {
-            int x = o->gpair_pairs[k], j = k - 1;
-            while (j >= a && o->pair_a[o->gpair_pairs[j]] > o->pair_a[x]) {
-                o->gpair_pairs[j + 1] = o->gpair_pairs[j];
-                --j;
-            }
-            o->gpair_pairs[j + 1] = x;
-        }
-    }
-    size_t total = o->gpair_offset[o->n_gpairs];
-    o->K_blocks = calloc(9 * total + 1, sizeof(double));
-    o->K0_blocks = calloc(9 * total + 1, sizeof(double));
-    o->M_blocks = calloc(total + 1, sizeof(double));
-    o->E_blocks = calloc(total + 1, sizeof(double));
-    if (!o->K_blocks || !o->K0_blocks || !o->M_blocks || !o->E_blocks)
-        return sem_error_set(err, SEM_ERR_NOMEM,
-                             "out of memory for the system blocks (%zu entries)", 9 * total);
-    return SEM_OK;
-}
-
 /* Per-point data in z-space: w * b at X_p - Xbar_i for each weight entry (mass), and the
  * point's part pairs. */
 static sem_status setup_points(sem_object *o, sem_error *err)
@@ -451,7 +268,7 @@ static sem_status setup_stiffness(sem_object *o, int assembly_chunk, sem_error *
         const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
         double sh[3] = {o->ref_X[0] - Xb[0], o->ref_X[1] - Xb[1], o->ref_X[2] - Xb[2]}, T[100];
         basis_shift(m, sh, T);
-        size_t n = gsize(o, d->part_origin[i]);
+        size_t n = sem_group_size(o, d->part_origin[i]);
         double *ps = o->pi_shared[i] = calloc((size_t)ma * n + 1, sizeof(double));
         if (!ps) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         for (int l = 1; l < m; ++l)
@@ -514,19 +331,11 @@ static void add_projected(const sem_object *o, int pa, int pb, const double *X, 
                           double *tmp)
 {
     int m = o->m;
-    int na = (int)gsize(o, o->d->part_origin[pa]), nb = (int)gsize(o, o->d->part_origin[pb]);
+    int na = (int)sem_group_size(o, o->d->part_origin[pa]), nb = (int)sem_group_size(o, o->d->part_origin[pb]);
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, m, nb, m, 1.0, X, ldx, o->pi_dense[pb],
                 nb, 0.0, tmp, nb);
     cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[pa], na, tmp,
                 nb, 1.0, block, nb);
-}
-
-static size_t max_group(const sem_object *o)
-{
-    size_t mx = 1;
-    for (int g = 0; g < o->n_groups; ++g)
-        if (gsize(o, g) > mx) mx = gsize(o, g);
-    return mx;
 }
 
 /* Constant blocks: mass with per-point density, and the error matrix. */
@@ -548,7 +357,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                     for (int l = 0; l < m; ++l) blk[k * m + l] += rv * ba[k] * bb[l];
             }
     }
-    size_t mg = max_group(o);
+    size_t mg = sem_max_group_size(o);
     double *tmp = malloc((size_t)m * mg * sizeof(double));
     if (!tmp) {
         free(Mz);
@@ -585,7 +394,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         o->n_orphans = 0;
         for (int i = 0; i < o->n_parts; ++i) {
             int g = o->d->part_origin[i];
-            size_t n = gsize(o, g);
+            size_t n = sem_group_size(o, g);
             int gp = o->gpair_lookup[(size_t)g * o->n_groups + g];
             if (gp < 0) continue;
             for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
@@ -673,7 +482,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                         free(rv);
                         return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
                     }
-                    size_t nb = gsize(o, gy);
+                    size_t nb = sem_group_size(o, gy);
                     o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[rc[x]] * nb + (size_t)o->ctrl_local[rc[y]]] +=
                         ax * rv[y];
                 }
@@ -695,7 +504,7 @@ static sem_status setup_constant_csr(sem_object *o, sem_error *err)
     o->me_start = calloc((size_t)nc + 1, sizeof(int));
     if (!o->me_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     for (int g = 0; g < o->n_gpairs; ++g) {
-        int ga = o->gpair_a[g], nb = (int)gsize(o, o->gpair_b[g]);
+        int ga = o->gpair_a[g], nb = (int)sem_group_size(o, o->gpair_b[g]);
         for (int x = o->group_start[ga]; x < o->group_start[ga + 1]; ++x) o->me_start[o->group_ctrl[x] + 1] += nb;
     }
     for (int c = 0; c < nc; ++c) o->me_start[c + 1] += o->me_start[c];
@@ -711,7 +520,7 @@ static sem_status setup_constant_csr(sem_object *o, sem_error *err)
     memcpy(fill, o->me_start, (size_t)nc * sizeof(int));
     for (int g = 0; g < o->n_gpairs; ++g) {
         int ga = o->gpair_a[g], gb = o->gpair_b[g];
-        size_t na = gsize(o, ga), nb = gsize(o, gb), off = o->gpair_offset[g];
+        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb), off = o->gpair_offset[g];
         const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
         for (size_t la = 0; la < na; ++la)
             for (size_t lb = 0; lb < nb; ++lb) {
@@ -756,7 +565,7 @@ static sem_status setup_system(sem_object *o, const sem_world_def *wd, sem_error
         }
         for (int g = 0; g < o->n_gpairs; ++g) {
             int ga = o->gpair_a[g], gb = o->gpair_b[g];
-            size_t na = gsize(o, ga), nb = gsize(o, gb);
+            size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
             for (size_t la = 0; la < na; ++la) {
                 int fa = o->free_index[o->group_ctrl[o->group_start[ga] + la]];
                 for (size_t lb = 0; lb < nb; ++lb) {
@@ -939,8 +748,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
     /* error stiffness: the discretization's default is for its E; rescale to ours */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
-    if ((st = setup_groups(o, err)) != SEM_OK) goto fail;
-    if ((st = setup_pairs(o, err)) != SEM_OK) goto fail;
+    if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     if ((st = setup_points(o, err)) != SEM_OK) goto fail;
     int chunk = w->def.advanced.assembly_chunk > 0 ? w->def.advanced.assembly_chunk : DEFAULT_ASSEMBLY_CHUNK;
     if ((st = setup_stiffness(o, chunk, err)) != SEM_OK) goto fail;
@@ -1095,7 +903,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
     const double *qc = centered(o, q);
     for (int i = 0; i < o->n_parts; ++i) {
         int g = d->part_origin[i];
-        size_t n = gsize(o, g);
+        size_t n = sem_group_size(o, g);
         const int *ctrl = o->group_ctrl + o->group_start[g];
         double *zi = o->z + (size_t)i * ma * 3;
         for (int k = 0; k < ma; ++k) {
@@ -1219,7 +1027,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
         memset(grad_q, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
         for (int i = 0; i < o->n_parts; ++i) {
             int g = d->part_origin[i];
-            size_t n = gsize(o, g);
+            size_t n = sem_group_size(o, g);
             const int *ctrl = o->group_ctrl + o->group_start[g];
             const double *gzi = o->grad_z + (size_t)i * ma * 3;
             for (int k = 0; k < ma; ++k) {
@@ -1238,7 +1046,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
      * calls run inside our OpenMP threads: OpenBLAS's own threads would only oversubscribe
      * the cores (measured: the rocket's step went from 18 ms to 11 ms), so BLAS is single
      * threaded here and gets its threads back for the factorization. */
-    size_t mg = max_group(o);
+    size_t mg = sem_max_group_size(o);
     int fail = 0;
     int blas_threads = openblas_get_num_threads();
     double *val = system ? sem_linear_solver_values(o->solver) : NULL;
@@ -1260,7 +1068,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
 #pragma omp for schedule(dynamic, 4)
         for (int g = 0; g < o->n_gpairs; ++g) {
             if (!U || o->gpair_a[g] > o->gpair_b[g]) continue;
-            int na = (int)gsize(o, o->gpair_a[g]), nb = (int)gsize(o, o->gpair_b[g]);
+            int na = (int)sem_group_size(o, o->gpair_a[g]), nb = (int)sem_group_size(o, o->gpair_b[g]);
             double *blk = o->K_blocks + 9 * o->gpair_offset[g];
             int written = 0; /* the first product overwrites the block (no clearing pass) */
             int k = o->gpair_pairs_start[g], end = o->gpair_pairs_start[g + 1];
@@ -1315,7 +1123,7 @@ static void blocks_multiply(const sem_object *o, double cM, double cE, double cK
     memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
     for (int g = 0; g < o->n_gpairs; ++g) {
         int ga = o->gpair_a[g], gb = o->gpair_b[g];
-        size_t na = gsize(o, ga), nb = gsize(o, gb);
+        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
         size_t off = o->gpair_offset[g];
         const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
         for (size_t la = 0; la < na; ++la) {
@@ -1347,7 +1155,7 @@ static void blocks_multiply(const sem_object *o, double cM, double cE, double cK
 static void fill_gpair(sem_object *o, int g, const double c[4], double *val)
 {
     if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see setup_system) */
-    size_t na = gsize(o, o->gpair_a[g]), nb = gsize(o, o->gpair_b[g]);
+    size_t na = sem_group_size(o, o->gpair_a[g]), nb = sem_group_size(o, o->gpair_b[g]);
     size_t off = o->gpair_offset[g];
     for (size_t la = 0; la < na; ++la) {
         const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
