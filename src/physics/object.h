@@ -20,6 +20,8 @@
 #include "linear_solver.h"
 #include "sem/simulation.h"
 
+struct sem_system;
+
 typedef struct sem_object {
     sem_object_def def;
     const sem_discretization *d;
@@ -81,8 +83,7 @@ typedef struct sem_object {
     int n_presc;
     int *free_index;           /* per ctrl: free index or -1 */
     int n_free;
-    int *map;                  /* per block entry (9 per scalar entry): CSC position or -1 */
-    sem_linear_solver *solver;
+    struct sem_system *system; /* the system it is solved in (system.h); not owned */
     /* z-space work */
     double *z;                 /* n_parts*ma x 3: shared-basis coefficients */
     double *grad_z;            /* n_parts*ma x 3 */

@@ -48,6 +48,7 @@
 
 #include "linear_solver.h"
 #include "loads.h"
+#include "system.h"
 #include "object.h"
 #include "world.h"
 
@@ -150,8 +151,6 @@ static void object_destroy(sem_object *o)
     free(o->presc_index);
     free(o->presc);
     free(o->free_index);
-    free(o->map);
-    sem_linear_solver_destroy(o->solver);
     free(o->z);
     free(o->grad_z);
     free(o->Kz);
@@ -165,8 +164,12 @@ static void object_destroy(sem_object *o)
 void sem_world_destroy(sem_world *w)
 {
     if (!w) return;
-    for (int i = 0; i < w->n_objects; ++i) object_destroy(w->objects[i]);
+    for (int i = 0; i < w->n_objects; ++i) {
+        sem_system_destroy(w->systems[i]);
+        object_destroy(w->objects[i]);
+    }
     free(w->objects);
+    free(w->systems);
     free(w);
 }
 
@@ -534,123 +537,6 @@ static sem_status setup_constant_csr(sem_object *o, sem_error *err)
     return SEM_OK;
 }
 
-/* CSC pattern of the free system (upper triangle) and the map from block entries. The
- * system is symmetric and its blocks are formed for group pairs ga <= gb only: an entry of
- * such a block maps to its own position or to its mirror's; blocks ga > gb map nowhere. */
-static sem_status setup_system(sem_object *o, const sem_world_def *wd, sem_error *err)
-{
-    int nf = 3 * o->n_free;
-    size_t total = o->gpair_offset[o->n_gpairs];
-    o->map = malloc((9 * total + 1) * sizeof(int));
-    int *count = calloc((size_t)nf + 1, sizeof(int));
-    if (!o->map || !count) {
-        free(count);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
-    }
-    /* pass 1: count entries per column (row <= col) */
-    for (int pass = 0; pass < 2; ++pass) {
-        int *rows = NULL;
-        int *fill = NULL;
-        if (pass == 1) {
-            for (int c = 0; c < nf; ++c) count[c + 1] += count[c];
-            rows = malloc(((size_t)count[nf] + 1) * sizeof(int));
-            fill = malloc(((size_t)nf + 1) * sizeof(int));
-            if (!rows || !fill) {
-                free(rows);
-                free(fill);
-                free(count);
-                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
-            }
-            memcpy(fill, count, (size_t)nf * sizeof(int));
-        }
-        for (int g = 0; g < o->n_gpairs; ++g) {
-            int ga = o->gpair_a[g], gb = o->gpair_b[g];
-            size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
-            for (size_t la = 0; la < na; ++la) {
-                int fa = o->free_index[o->group_ctrl[o->group_start[ga] + la]];
-                for (size_t lb = 0; lb < nb; ++lb) {
-                    int fb = o->free_index[o->group_ctrl[o->group_start[gb] + lb]];
-                    for (int dd = 0; dd < 9; ++dd) {
-                        int d1 = dd / 3, d2 = dd % 3;
-                        size_t idx = 9 * o->gpair_offset[g] + (la * 9 + (size_t)dd) * nb + lb;
-                        if (fa < 0 || fb < 0) {
-                            if (pass == 1) o->map[idx] = -1;
-                            continue;
-                        }
-                        int r = 3 * fa + d1, c = 3 * fb + d2;
-                        if (ga > gb || (ga == gb && r > c)) {
-                            if (pass == 1) o->map[idx] = -1;
-                            continue;
-                        }
-                        if (r > c) {
-                            int x = r;
-                            r = c;
-                            c = x;
-                        }
-                        if (pass == 0)
-                            count[c + 1]++;
-                        else {
-                            rows[fill[c]] = r;
-                            o->map[idx] = fill[c]++;
-                        }
-                    }
-                }
-            }
-        }
-        if (pass == 1) {
-            /* Each (r,c) occurs once: group pairs are distinct and a control point is in one
-             * group. Sort rows within columns and remap positions. */
-            int *perm = malloc(((size_t)count[nf] + 1) * sizeof(int));
-            int *inv = malloc(((size_t)count[nf] + 1) * sizeof(int));
-            if (!perm || !inv) {
-                free(perm);
-                free(inv);
-                free(rows);
-                free(fill);
-                free(count);
-                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-            }
-            for (int c = 0; c < nf; ++c) {
-                int a = count[c], b = count[c + 1];
-                /* insertion sort is fine for short columns; use counting by row otherwise */
-                for (int k = a; k < b; ++k) perm[k] = k;
-                for (int k = a + 1; k < b; ++k) {
-                    int x = perm[k], j = k - 1;
-                    while (j >= a && rows[perm[j]] > rows[x]) {
-                        perm[j + 1] = perm[j];
-                        --j;
-                    }
-                    perm[j + 1] = x;
-                }
-                for (int k = a; k < b; ++k) inv[perm[k]] = k;
-            }
-            int *sorted = malloc(((size_t)count[nf] + 1) * sizeof(int));
-            if (!sorted) {
-                free(perm);
-                free(inv);
-                free(rows);
-                free(fill);
-                free(count);
-                return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-            }
-            for (int k = 0; k < count[nf]; ++k) sorted[inv[k]] = rows[k];
-            for (size_t k = 0; k < 9 * total; ++k)
-                if (o->map[k] >= 0) o->map[k] = inv[o->map[k]];
-            sem_status st = sem_linear_solver_create(nf, count, sorted, wd->solver, &o->solver, err);
-            if (st == SEM_OK) sem_linear_solver_remap(o->solver, o->map, 9 * total);
-            free(sorted);
-            free(perm);
-            free(inv);
-            free(rows);
-            free(fill);
-            free(count);
-            return st;
-        }
-    }
-    free(count);
-    return SEM_OK;
-}
-
 static const sem_material *material_of_part(const sem_object *o, const sem_object_def *def, int part)
 {
     if (def->part_material && o->part_mats) {
@@ -661,7 +547,7 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
 }
 
 static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
-                                   const double *system, sem_error *err);
+                                   const sem_fill_target *fill, sem_error *err);
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
 {
@@ -675,6 +561,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         return -1;
     }
     sem_object *o = calloc(1, sizeof *o);
+    sem_system *sys = NULL;
     if (!o) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         return -1;
@@ -701,11 +588,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->f_gravity = calloc(nq, sizeof(double));
     o->point_material = malloc(((size_t)o->n_quad + 1) * sizeof(*o->point_material));
     o->point_rho_vol = malloc(((size_t)o->n_quad + 1) * sizeof(double));
-    o->free_index = malloc((size_t)o->n_ctrl * sizeof(int));
     o->z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
     o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double)); /* room for ma rows */
     if (!o->q || !o->v || !o->q0 || !o->f_gravity || !o->point_material || !o->point_rho_vol ||
-        !o->free_index || !o->z || !o->grad_z) {
+        !o->z || !o->grad_z) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -744,8 +630,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->def.part_material = NULL; /* the caller's arrays: read above, not kept */
     o->def.part_materials = NULL;
     if ((st = sem_loads_init(o, def, err)) != SEM_OK) goto fail;
-    o->n_free = 0;
-    for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
+    if ((st = sem_object_free_dofs(o, err)) != SEM_OK) goto fail;
     /* error stiffness: the discretization's default is for its E; rescale to ours */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
@@ -762,7 +647,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         goto fail;
     }
     if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
-    if (o->n_free > 0 && (st = setup_system(o, &w->def, err)) != SEM_OK) goto fail;
+    if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
     if ((st = assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
     memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
@@ -796,16 +681,20 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if (w->n_objects == w->cap) {
         int nc = w->cap ? 2 * w->cap : 4;
         sem_object **x = realloc(w->objects, (size_t)nc * sizeof *x);
-        if (!x) {
+        if (x) w->objects = x;
+        sem_system **y = x ? realloc(w->systems, (size_t)nc * sizeof *y) : NULL;
+        if (y) w->systems = y;
+        if (!x || !y) {
             sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        w->objects = x;
         w->cap = nc;
     }
     w->objects[w->n_objects] = o;
+    w->systems[w->n_objects] = sys;
     return w->n_objects++;
 fail:
+    sem_system_destroy(sys);
     object_destroy(o);
     return -1;
 }
@@ -886,12 +775,10 @@ static void pair_sum(int np, const int *point, const double *w, int e0, int e1, 
     }
 }
 
-static void fill_gpair(sem_object *o, int g, const double c[4], double *val);
-
 /* system: NULL, or the coefficients (cM, cE, cK, cD) of fill_system, whose work is then
  * done group pair by group pair as each K block is formed (while it is in cache). */
 static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
-                                   const double *system, sem_error *err)
+                                   const sem_fill_target *fill, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *W = &d->W;
@@ -1049,7 +936,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
     size_t mg = sem_max_group_size(o);
     int fail = 0;
     int blas_threads = openblas_get_num_threads();
-    double *val = system ? sem_linear_solver_values(o->solver) : NULL;
+    double *val = fill ? sem_system_values(fill->system) : NULL;
     openblas_set_num_threads(1);
 #pragma omp parallel num_threads(nth) reduction(| : fail)
     {
@@ -1089,7 +976,7 @@ static sem_status assemble_elastic(sem_object *o, const double *q, int want_hess
                 written = 1;
             }
             if (!written) memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
-            if (system) fill_gpair(o, g, system, val);
+            if (fill) sem_system_fill_gpair(fill->system, fill->object, g, fill->coef, val);
         }
         free(U);
     }
@@ -1150,60 +1037,8 @@ static void blocks_multiply(const sem_object *o, double cM, double cE, double cK
     }
 }
 
-/* The solver's values of group pair g (ga <= gb): c[0] M + c[1] 2 M_eps + c[2] K + c[3] K0.
- * Every block entry has its own position (or none), so group pairs are independent. */
-static void fill_gpair(sem_object *o, int g, const double c[4], double *val)
-{
-    if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see setup_system) */
-    size_t na = sem_group_size(o, o->gpair_a[g]), nb = sem_group_size(o, o->gpair_b[g]);
-    size_t off = o->gpair_offset[g];
-    for (size_t la = 0; la < na; ++la) {
-        const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
-        for (int dd = 0; dd < 9; ++dd) {
-            int diag = dd / 3 == dd % 3;
-            size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
-            const int *map = o->map + row;
-            const double *K = o->K_blocks + row, *K0 = o->K0_blocks + row;
-            for (size_t lb = 0; lb < nb; ++lb) {
-                int pos = map[lb];
-                if (pos < 0) continue;
-                double v = c[2] * K[lb] + c[3] * K0[lb];
-                if (diag) v += c[0] * Ms[lb] + 2.0 * c[1] * Es[lb];
-                val[pos] = v;
-            }
-        }
-    }
-}
-
-/* Fills the solver's values with cM M + cE 2 M_eps + cK K + cD K0 on free dofs. */
-static void fill_system(sem_object *o, double cM, double cE, double cK, double cD)
-{
-    double *val = sem_linear_solver_values(o->solver);
-    const double c[4] = {cM, cE, cK, cD};
-#pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
-    for (int g = 0; g < o->n_gpairs; ++g) fill_gpair(o, g, c, val);
-}
-
 /* ---------------------------------------------------------------------------------- */
 /* steppers                                                                            */
-
-static void gather_free(const sem_object *o, const double *full, double *fr)
-{
-    for (int c = 0; c < o->n_ctrl; ++c) {
-        int f = o->free_index[c];
-        if (f < 0) continue;
-        for (int k = 0; k < 3; ++k) fr[3 * f + k] = full[3 * c + k];
-    }
-}
-
-static void scatter_free(const sem_object *o, const double *fr, double *full)
-{
-    for (int c = 0; c < o->n_ctrl; ++c) {
-        int f = o->free_index[c];
-        if (f < 0) continue;
-        for (int k = 0; k < 3; ++k) full[3 * c + k] = fr[3 * f + k];
-    }
-}
 
 static int finite_vec(const double *x, size_t n)
 {
@@ -1228,8 +1063,9 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
         goto done;
     }
     /* the system matrix's values are written as its K blocks are formed */
-    const double coef[4] = {1.0 + h * a, h * h * o->gamma, h * h, h * b};
-    if ((st = assemble_elastic(o, o->q, 1, g, o->n_free > 0 ? coef : NULL, err)) != SEM_OK) goto done;
+    sem_system *sys = o->system;
+    const sem_fill_target fill = {sys, 0, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
+    if ((st = assemble_elastic(o, o->q, 1, g, sys->n_free > 0 ? &fill : NULL, err)) != SEM_OK) goto done;
     sem_external_force(o, w->time, f);
     /* f_total = f_ext - grad V - 2 gamma M_eps q */
     error_term(o, o->q, tmp);
@@ -1251,13 +1087,13 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
         for (size_t i = 0; i < n; ++i) rhs[i] -= tmp[i];
     }
     if (o->n_free > 0) {
-        st = sem_linear_solver_factorize(o->solver, err);
-        w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        st = sem_system_factorize(sys, err);
+        w->last_factor_s += sem_system_factor_seconds(sys);
         w->counters.factorizations++;
         if (st != SEM_OK) goto done;
-        gather_free(o, rhs, fr);
-        if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
-        scatter_free(o, fr, vp);
+        sem_system_gather_free(sys, rhs, fr);
+        if ((st = sem_system_solve(sys, fr, fr, err)) != SEM_OK) goto done;
+        sem_system_scatter_free(sys, fr, vp);
     }
     if (!finite_vec(vp, n)) {
         st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
@@ -1347,7 +1183,7 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
                 for (size_t i = 0; i < n; ++i) g[i] += tmp[i];
             }
         }
-        gather_free(o, g, fr);
+        sem_system_gather_free(o->system, g, fr);
         double gnorm = 0, fscale = 0;
         for (int i = 0; i < 3 * o->n_free; ++i) gnorm += fr[i] * fr[i];
         gnorm = sqrt(gnorm);
@@ -1356,9 +1192,9 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
         if (g0norm < 0) g0norm = gnorm;
         double scale = fmax(g0norm, fscale);
         if (o->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) break;
-        fill_system(o, cM, o->gamma, 1.0, cD);
-        st = sem_linear_solver_factorize(o->solver, err);
-        w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+        sem_system_fill(o->system, cM, 1.0, 1.0, cD);
+        st = sem_system_factorize(o->system, err);
+        w->last_factor_s += sem_system_factor_seconds(o->system);
         w->counters.factorizations++;
         if (st == SEM_ERR_NUMERIC && o->exact_hessian) {
             /* the exact system is not positive definite (e.g. a buckled or unstable
@@ -1367,15 +1203,15 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
             exact_allowed = 0;
             w->counters.exact_hessian_fallbacks++;
             if ((st = assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
-            fill_system(o, cM, o->gamma, 1.0, cD);
-            st = sem_linear_solver_factorize(o->solver, err);
-            w->last_factor_s += sem_linear_solver_last_factor_seconds(o->solver);
+            sem_system_fill(o->system, cM, 1.0, 1.0, cD);
+            st = sem_system_factorize(o->system, err);
+            w->last_factor_s += sem_system_factor_seconds(o->system);
             w->counters.factorizations++;
         }
         if (st != SEM_OK) goto done;
-        if ((st = sem_linear_solver_solve(o->solver, fr, fr, err)) != SEM_OK) goto done;
+        if ((st = sem_system_solve(o->system, fr, fr, err)) != SEM_OK) goto done;
         memset(dq, 0, n * sizeof(double));
-        scatter_free(o, fr, dq);
+        sem_system_scatter_free(o->system, fr, dq);
         double slope = 0;
         for (size_t i = 0; i < n; ++i) slope -= dq[i] * g[i];
         /* ENERGY uses dq as scratch: keep the Newton direction apart */
@@ -1493,7 +1329,8 @@ sem_world_counters sem_world_get_counters(const sem_world *w) { return w->counte
 
 const char *sem_world_solver_name(const sem_world *w, int i)
 {
-    return w->objects[i]->solver ? sem_linear_solver_name(w->objects[i]->solver) : "none";
+    const sem_linear_solver *solver = w->systems[i]->solver;
+    return solver ? sem_linear_solver_name(solver) : "none";
 }
 
 double sem_world_object_nnz_percent(const sem_world *w, int i)
