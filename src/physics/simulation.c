@@ -46,6 +46,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "assembly.h"
 #include "linear_solver.h"
 #include "loads.h"
 #include "system.h"
@@ -173,370 +174,6 @@ void sem_world_destroy(sem_world *w)
     free(w);
 }
 
-/* Per-point data in z-space: w * b at X_p - Xbar_i for each weight entry (mass), and the
- * point's part pairs. */
-static sem_status setup_points(sem_object *o, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    const sem_csr *W = &d->W;
-    size_t n_entries = sem_csr_nnz(W);
-    int m = o->m;
-    o->entry_basis = malloc((n_entries * (size_t)m + 1) * sizeof(double));
-    o->entry_pair_offset = malloc(((size_t)o->n_quad + 1) * sizeof(int));
-    if (!o->entry_basis || !o->entry_pair_offset)
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    size_t n_pp = 0;
-    o->entry_pair_offset[0] = 0;
-    for (int p = 0; p < o->n_quad; ++p) {
-        size_t k = (size_t)(W->row_start[p + 1] - W->row_start[p]);
-        n_pp += k * k;
-        o->entry_pair_offset[p + 1] = (int)n_pp;
-    }
-    o->point_pairs = malloc((n_pp + 1) * sizeof(int));
-    if (!o->point_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-#pragma omp parallel for schedule(static)
-    for (int p = 0; p < o->n_quad; ++p) {
-        const double *X = d->quad_X + 3 * (size_t)p;
-        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-        int pp = o->entry_pair_offset[p];
-        for (int r = r0; r < r1; ++r) {
-            int i = W->col[r];
-            const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
-            double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]};
-            double b[10];
-            sem_polynomial_basis(o->d->order, dX, b, NULL);
-            double w = W->val[r];
-            for (int k = 0; k < m; ++k) o->entry_basis[(size_t)r * m + k] = w * b[k];
-            for (int r2 = r0; r2 < r1; ++r2)
-                o->point_pairs[pp++] = o->pair_lookup[(size_t)i * o->n_parts + W->col[r2]];
-        }
-    }
-    return SEM_OK;
-}
-
-/* Points per assembly chunk when the world's settings give none. */
-#define DEFAULT_ASSEMBLY_CHUNK 8192
-
-/* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
- * (W rows list parts in increasing order). */
-static int pair_has_points(const sem_object *o, int pr)
-{
-    return o->plist_start[pr + 1] > o->plist_start[pr];
-}
-
-/* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
- * part's own basis, b(X - Xbar_i) with s = ref_X - Xbar_i, to the shared one, b(X - ref_X). */
-static void basis_shift(int m, const double s[3], double *T)
-{
-    memset(T, 0, (size_t)m * m * sizeof(double));
-    for (int k = 0; k < m; ++k) T[k * m + k] = 1.0;
-    for (int e = 0; e < 3; ++e) T[(1 + e) * m] = s[e];
-    if (m < 10) return;
-    /* b4..b9 = xy, xz, yz, x^2, y^2, z^2 */
-    static const int pa[6] = {0, 0, 1, 0, 1, 2}, pb[6] = {1, 2, 2, 0, 1, 2};
-    for (int q = 0; q < 6; ++q) {
-        double *row = T + (size_t)(4 + q) * m;
-        int a = pa[q], b = pb[q];
-        row[0] = s[a] * s[b];
-        row[1 + a] += s[b];
-        row[1 + b] += s[a];
-    }
-}
-
-/* The stiffness in one shared basis. With Eq. 15, a part's contribution to F at point p
- * is w_i (grad b(X_p - Xbar_i))^T z_i = w_i (grad b(X_p - ref))^T (T_i^T z_i): every part
- * at p shares the point's D_p = grad b(X_p - ref), so a part pair's block is
- *   Kz_ab = sum_p w_a w_b N_p,   N_p = vol_p D_p^T (d2psi/dF2) D_p (per coordinate pair),
- * N_p is computed once per point (not once per part pair), and Kz_ab = Kz_ba is symmetric.
- * The change of basis goes into Pi: pi_shared_i = T_i^T Pi_i. The constant basis function
- * has no gradient, so only rows 1..m-1 take part. */
-static sem_status setup_stiffness(sem_object *o, int assembly_chunk, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    const sem_csr *W = &d->W;
-    int m = o->m, ma = m - 1;
-    o->ma = ma;
-    /* the shared origin: the volume centroid (keeps the monomials small) */
-    double vsum = 0;
-    for (int k = 0; k < 3; ++k) o->ref_X[k] = 0;
-    for (int p = 0; p < o->n_quad; ++p) {
-        double v = d->quad_volume[p];
-        vsum += v;
-        for (int k = 0; k < 3; ++k) o->ref_X[k] += v * d->quad_X[3 * (size_t)p + k];
-    }
-    for (int k = 0; k < 3; ++k) o->ref_X[k] = vsum > 0 ? o->ref_X[k] / vsum : 0;
-    o->pi_shared = calloc((size_t)(o->n_parts > 0 ? o->n_parts : 1), sizeof(double *));
-    if (!o->pi_shared) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int i = 0; i < o->n_parts; ++i) {
-        const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
-        double sh[3] = {o->ref_X[0] - Xb[0], o->ref_X[1] - Xb[1], o->ref_X[2] - Xb[2]}, T[100];
-        basis_shift(m, sh, T);
-        size_t n = sem_group_size(o, d->part_origin[i]);
-        double *ps = o->pi_shared[i] = calloc((size_t)ma * n + 1, sizeof(double));
-        if (!ps) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        for (int l = 1; l < m; ++l)
-            for (int k = 0; k < m; ++k) {
-                double t = T[k * m + l];
-                if (t == 0) continue;
-                const double *src = o->pi_dense[i] + (size_t)k * n;
-                double *dst = ps + (size_t)(l - 1) * n;
-                for (size_t j = 0; j < n; ++j) dst[j] += t * src[j];
-            }
-    }
-    o->point_D = malloc(((size_t)o->n_quad * ma * 3 + 1) * sizeof(double));
-    if (!o->point_D) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int p = 0; p < o->n_quad; ++p) {
-        const double *X = d->quad_X + 3 * (size_t)p;
-        double y[3] = {X[0] - o->ref_X[0], X[1] - o->ref_X[1], X[2] - o->ref_X[2]}, db[30];
-        sem_polynomial_basis(o->d->order, y, NULL, db);
-        double *D = o->point_D + (size_t)p * ma * 3;
-        for (int k = 1; k < m; ++k)
-            for (int e = 0; e < 3; ++e) D[(k - 1) * 3 + e] = db[e * m + k];
-    }
-    /* the points of each upper part pair, in point order, with w_a w_b */
-    o->plist_start = calloc((size_t)o->n_pairs + 1, sizeof(int));
-    o->plist_cursor = malloc(((size_t)o->n_pairs + 1) * sizeof(int));
-    if (!o->plist_start || !o->plist_cursor) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int p = 0; p < o->n_quad; ++p)
-        for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
-            for (int r2 = r; r2 < W->row_start[p + 1]; ++r2)
-                o->plist_start[o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]] + 1]++;
-    for (int k = 0; k < o->n_pairs; ++k) o->plist_start[k + 1] += o->plist_start[k];
-    size_t nl = (size_t)o->plist_start[o->n_pairs];
-    o->plist_point = malloc((nl + 1) * sizeof(int));
-    o->plist_w = malloc((nl + 1) * sizeof(double));
-    if (!o->plist_point || !o->plist_w) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    memcpy(o->plist_cursor, o->plist_start, (size_t)o->n_pairs * sizeof(int));
-    for (int p = 0; p < o->n_quad; ++p)
-        for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r)
-            for (int r2 = r; r2 < W->row_start[p + 1]; ++r2) {
-                int pr = o->pair_lookup[(size_t)W->col[r] * o->n_parts + W->col[r2]];
-                o->plist_point[o->plist_cursor[pr]] = p;
-                o->plist_w[o->plist_cursor[pr]++] = W->val[r] * W->val[r2];
-            }
-    int n3 = 3 * ma;
-    o->n_packed = n3 * (n3 + 1) / 2;
-    /* points are assembled in chunks so that N stays small (25 MB at most) */
-    o->chunk = o->n_quad < assembly_chunk ? (o->n_quad > 0 ? o->n_quad : 1) : assembly_chunk;
-    o->N_chunk = malloc(((size_t)o->chunk * o->n_packed + 1) * sizeof(double));
-    o->Kz = malloc(((size_t)o->n_pairs * n3 * n3 + 1) * sizeof(double));
-    o->Kz_packed = o->chunk < o->n_quad
-                       ? malloc(((size_t)o->n_pairs * o->n_packed + 1) * sizeof(double))
-                       : calloc(1, sizeof(double));
-    if (!o->N_chunk || !o->Kz || !o->Kz_packed)
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the stiffness blocks");
-    return SEM_OK;
-}
-
-/* Adds Pi_a^T X Pi_b for a part pair into its group-pair block. X is m x m with leading
- * dimension ldx; block is |Ga| x |Gb| row-major; tmp has room for m x |Gb|. */
-static void add_projected(const sem_object *o, int pa, int pb, const double *X, int ldx, double *block,
-                          double *tmp)
-{
-    int m = o->m;
-    int na = (int)sem_group_size(o, o->d->part_origin[pa]), nb = (int)sem_group_size(o, o->d->part_origin[pb]);
-    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, m, nb, m, 1.0, X, ldx, o->pi_dense[pb],
-                nb, 0.0, tmp, nb);
-    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[pa], na, tmp,
-                nb, 1.0, block, nb);
-}
-
-/* Constant blocks: mass with per-point density, and the error matrix. */
-static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
-{
-    int m = o->m, np = o->n_pairs;
-    double *Mz = calloc((size_t)np * m * m + 1, sizeof(double));
-    if (!Mz) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    const sem_csr *W = &o->d->W;
-    for (int p = 0; p < o->n_quad; ++p) {
-        double rv = o->point_rho_vol[p];
-        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-        int pp = o->entry_pair_offset[p];
-        for (int a = r0; a < r1; ++a)
-            for (int b = r0; b < r1; ++b) {
-                double *blk = Mz + (size_t)o->point_pairs[pp++] * m * m;
-                const double *ba = o->entry_basis + (size_t)a * m, *bb = o->entry_basis + (size_t)b * m;
-                for (int k = 0; k < m; ++k)
-                    for (int l = 0; l < m; ++l) blk[k * m + l] += rv * ba[k] * bb[l];
-            }
-    }
-    size_t mg = sem_max_group_size(o);
-    double *tmp = malloc((size_t)m * mg * sizeof(double));
-    if (!tmp) {
-        free(Mz);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    for (int k = 0; k < np; ++k) {
-        int g = o->part_pair_gpair[k];
-        add_projected(o, o->pair_a[k], o->pair_b[k], Mz + (size_t)k * m * m, m,
-                      o->M_blocks + o->gpair_offset[g], tmp);
-    }
-    free(tmp);
-    free(Mz);
-    /* Control points that no boundary sample sees (their basis functions are supported
-     * only where a trim removed the surface) appear in no term of the discretization, so
-     * the system would be singular. Each such point is tied to its own part's polynomial
-     * at its rest position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical
-     * control point's error term. It vanishes for every affine motion (the control points
-     * of an affinely mapped NURBS are affinely mapped), so the patch test is unaffected. */
-    {
-        const sem_csr *J = &o->d->J_hat;
-        double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
-        if (!colw) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        for (int r = 0; r < J->n_rows; ++r)
-            for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
-                colw[J->col[e]] += o->d->sample_area[r] * J->val[e] * J->val[e];
-        double mean = 0;
-        for (int c = 0; c < o->n_ctrl; ++c) mean += colw[c];
-        mean /= o->n_ctrl > 0 ? o->n_ctrl : 1;
-        double *row = malloc(mg * sizeof(double) + 1);
-        if (!row) {
-            free(colw);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        o->n_orphans = 0;
-        for (int i = 0; i < o->n_parts; ++i) {
-            int g = o->d->part_origin[i];
-            size_t n = sem_group_size(o, g);
-            int gp = o->gpair_lookup[(size_t)g * o->n_groups + g];
-            if (gp < 0) continue;
-            for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
-                if (colw[c] > 1e-10 * mean) continue;
-                const double *X = o->q0 + 3 * (size_t)c, *Xb = o->d->origin_X + 3 * (size_t)g;
-                double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
-                sem_polynomial_basis(o->d->order, dX, b, NULL);
-                for (size_t l = 0; l < n; ++l) {
-                    double v = 0;
-                    for (int k = 0; k < m; ++k) v += b[k] * o->pi_dense[i][(size_t)k * n + l];
-                    row[l] = -v;
-                }
-                row[o->ctrl_local[c]] += 1.0;
-                double *blk = o->E_blocks + o->gpair_offset[gp];
-                for (size_t a = 0; a < n; ++a)
-                    if (row[a] != 0)
-                        for (size_t bb = 0; bb < n; ++bb) blk[a * n + bb] += mean * row[a] * row[bb];
-                o->n_orphans++;
-            }
-        }
-        free(row);
-        free(colw);
-    }
-    /* Error matrix (Eq. 16) as a sum of outer products of r_s = Gamma_s - J_s, so it is
-     * positive semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J
-     * cancels large terms, and its round-off can leave small negative eigenvalues exactly in
-     * the directions the mass matrix does not see (M has rank at most the number of
-     * quadrature points per coordinate), which makes M + h^2 (K + 2 gamma M_eps) indefinite. */
-    {
-        const sem_csr *G = &o->d->Gamma_samples, *J = &o->d->J_hat;
-        int *rc = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
-        double *rv = malloc(((size_t)o->n_ctrl + 1) * sizeof(double));
-        if (!rc || !rv) {
-            free(rc);
-            free(rv);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        /* A collapsed edge (a sphere's pole) has a zero area element, so its samples would
-         * drop out, and with them the only information that fixes the control points of the
-         * collapsed row: the system becomes singular. Every sample keeps at least 5% of its
-         * part's mean sample weight. */
-        double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
-        int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
-        if (!part_mean || !part_count) {
-            free(part_mean);
-            free(part_count);
-            free(rc);
-            free(rv);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        for (int r = 0; r < o->d->n_samples; ++r) {
-            part_mean[o->d->sample_part[r]] += o->d->sample_area[r];
-            part_count[o->d->sample_part[r]]++;
-        }
-        for (int i = 0; i < o->n_parts; ++i)
-            if (part_count[i]) part_mean[i] /= part_count[i];
-        for (int r = 0; r < G->n_rows; ++r) {
-            /* merge the sorted rows of Gamma_s and J_s */
-            int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
-            int n = 0;
-            while (a < ae || b < be) {
-                if (b >= be || (a < ae && G->col[a] < J->col[b])) {
-                    rc[n] = G->col[a];
-                    rv[n++] = G->val[a++];
-                } else if (a >= ae || J->col[b] < G->col[a]) {
-                    rc[n] = J->col[b];
-                    rv[n++] = -J->val[b++];
-                } else {
-                    rc[n] = G->col[a];
-                    rv[n++] = G->val[a++] - J->val[b++];
-                }
-            }
-            double area = fmax(o->d->sample_area[r], 0.05 * part_mean[o->d->sample_part[r]]);
-            for (int x = 0; x < n; ++x) {
-                int gx = o->ctrl_group[rc[x]];
-                double ax = area * rv[x];
-                if (ax == 0) continue;
-                for (int y = 0; y < n; ++y) {
-                    int gy = o->ctrl_group[rc[y]];
-                    int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
-                    if (gp < 0) {
-                        free(part_mean);
-                        free(part_count);
-                        free(rc);
-                        free(rv);
-                        return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
-                    }
-                    size_t nb = sem_group_size(o, gy);
-                    o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[rc[x]] * nb + (size_t)o->ctrl_local[rc[y]]] +=
-                        ax * rv[y];
-                }
-            }
-        }
-        free(part_mean);
-        free(part_count);
-        free(rc);
-        free(rv);
-    }
-    return SEM_OK;
-}
-
-/* M and E_blocks as CSR rows over control points, for products with them alone (the
- * right-hand side and the error force of every step) run in parallel by rows. */
-static sem_status setup_constant_csr(sem_object *o, sem_error *err)
-{
-    int nc = o->n_ctrl;
-    o->me_start = calloc((size_t)nc + 1, sizeof(int));
-    if (!o->me_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    for (int g = 0; g < o->n_gpairs; ++g) {
-        int ga = o->gpair_a[g], nb = (int)sem_group_size(o, o->gpair_b[g]);
-        for (int x = o->group_start[ga]; x < o->group_start[ga + 1]; ++x) o->me_start[o->group_ctrl[x] + 1] += nb;
-    }
-    for (int c = 0; c < nc; ++c) o->me_start[c + 1] += o->me_start[c];
-    size_t nnz = (size_t)o->me_start[nc];
-    o->me_col = malloc((nnz + 1) * sizeof(int));
-    o->me_M = malloc((nnz + 1) * sizeof(double));
-    o->me_E = malloc((nnz + 1) * sizeof(double));
-    int *fill = malloc(((size_t)nc + 1) * sizeof(int));
-    if (!o->me_col || !o->me_M || !o->me_E || !fill) {
-        free(fill);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    memcpy(fill, o->me_start, (size_t)nc * sizeof(int));
-    for (int g = 0; g < o->n_gpairs; ++g) {
-        int ga = o->gpair_a[g], gb = o->gpair_b[g];
-        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb), off = o->gpair_offset[g];
-        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
-        for (size_t la = 0; la < na; ++la)
-            for (size_t lb = 0; lb < nb; ++lb) {
-                int k = fill[ca[la]]++;
-                o->me_col[k] = cb[lb];
-                o->me_M[k] = o->M_blocks[off + la * nb + lb];
-                o->me_E[k] = o->E_blocks[off + la * nb + lb];
-            }
-    }
-    free(fill);
-    return SEM_OK;
-}
-
 static const sem_material *material_of_part(const sem_object *o, const sem_object_def *def, int part)
 {
     if (def->part_material && o->part_mats) {
@@ -545,9 +182,6 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
     }
     return &o->def.material;
 }
-
-static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
-                                   const sem_fill_target *fill, sem_error *err);
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
 {
@@ -634,11 +268,8 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     /* error stiffness: the discretization's default is for its E; rescale to ours */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
-    if ((st = setup_points(o, err)) != SEM_OK) goto fail;
-    int chunk = w->def.advanced.assembly_chunk > 0 ? w->def.advanced.assembly_chunk : DEFAULT_ASSEMBLY_CHUNK;
-    if ((st = setup_stiffness(o, chunk, err)) != SEM_OK) goto fail;
-    if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
-    if ((st = setup_constant_csr(o, err)) != SEM_OK) goto fail;
+    if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
+    if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
@@ -649,7 +280,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
     if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
-    if ((st = assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
+    if ((st = sem_assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
     memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
     /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
     {
@@ -700,344 +331,6 @@ fail:
 }
 
 /* ---------------------------------------------------------------------------------- */
-/* assembly                                                                            */
-
-/* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
- * energies are translation invariant, but evaluated at q far from the origin their
- * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
- * slowly lose momentum conservation. Evaluating at the centred q removes that. */
-static const double *centered(sem_object *o, const double *q)
-{
-    double mean[3] = {0, 0, 0};
-    for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) mean[k] += q[3 * c + k];
-    for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
-    for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) o->qc[3 * c + k] = q[3 * c + k] - mean[k];
-    return o->qc;
-}
-
-static void blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
-                            const double *x, double *y);
-
-/* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (in grad). */
-static double error_term(sem_object *o, const double *q, double *grad)
-{
-    const double *qc = centered(o, q);
-    blocks_multiply(o, 0, o->gamma, 0, 0, qc, grad);
-    double e = 0;
-    for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) e += 0.5 * qc[i] * grad[i];
-    return e;
-}
-
-/* Elastic energy, gradient in q (if grad_q) and, if want_hessian, K_blocks. */
-/* The kernels below are element-wise (no reordered sums, and ISO C mode keeps the compiler
- * from contracting to FMA), so every clone gives the same bits. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
-    !defined(SEM_NO_CLONES)
-#define SEM_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define SEM_VECTOR_CLONES
-#endif
-
-/* One point's N = vol D^T (d2psi/dF2) D, rows and columns (d, k) (coordinate d, basis
- * function k = 1..ma), as the packed upper triangle (row by row) of the 3ma x 3ma matrix:
- * N[(d,k),(d',k')] = vol sum_{e,e'} D[k][e] H[(d,e),(d',e')] D[k'][e']. */
-SEM_VECTOR_CLONES
-static void point_stiffness(int ma, double vol, const double *H, const double *D, double *N)
-{
-    int n3 = 3 * ma;
-    double HD[9 * 27]; /* HD[(d,e)][(d',k')] = sum_e' H[(d,e),(d',e')] D[k'][e'] */
-    for (int de = 0; de < 9; ++de)
-        for (int d2 = 0; d2 < 3; ++d2) {
-            const double *h = H + de * 9 + d2 * 3;
-            for (int k2 = 0; k2 < ma; ++k2)
-                HD[de * n3 + d2 * ma + k2] = h[0] * D[k2 * 3 + 0] + h[1] * D[k2 * 3 + 1] + h[2] * D[k2 * 3 + 2];
-        }
-    int idx = 0;
-    for (int d1 = 0; d1 < 3; ++d1)
-        for (int k1 = 0; k1 < ma; ++k1) {
-            double a0 = vol * D[k1 * 3 + 0], a1 = vol * D[k1 * 3 + 1], a2 = vol * D[k1 * 3 + 2];
-            const double *h0 = HD + (d1 * 3 + 0) * n3, *h1 = HD + (d1 * 3 + 1) * n3, *h2 = HD + (d1 * 3 + 2) * n3;
-            for (int j = d1 * ma + k1; j < n3; ++j) N[idx++] = a0 * h0[j] + a1 * h1[j] + a2 * h2[j];
-        }
-}
-
-/* acc += sum over the pair's entries [e0, e1) of w_e N_{point e} (points from c0 on). */
-SEM_VECTOR_CLONES
-static void pair_sum(int np, const int *point, const double *w, int e0, int e1, int c0,
-                     const double *N, double *acc)
-{
-    for (int e = e0; e < e1; ++e) {
-        const double *n = N + (size_t)(point[e] - c0) * np;
-        double we = w[e];
-        for (int x = 0; x < np; ++x) acc[x] += we * n[x];
-    }
-}
-
-/* system: NULL, or the coefficients (cM, cE, cK, cD) of fill_system, whose work is then
- * done group pair by group pair as each K block is formed (while it is in cache). */
-static sem_status assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
-                                   const sem_fill_target *fill, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    const sem_csr *W = &d->W;
-    int ma = o->ma, n3 = 3 * ma, np = o->n_packed;
-    size_t nz = (size_t)o->n_parts * ma * 3;
-    size_t bs = (size_t)n3 * n3;
-    /* z_i = pi_shared_i Q (shared-basis coefficients), with Q centred (translation
-     * invariance; see centered) */
-    const double *qc = centered(o, q);
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = d->part_origin[i];
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        double *zi = o->z + (size_t)i * ma * 3;
-        for (int k = 0; k < ma; ++k) {
-            const double *row = o->pi_shared[i] + (size_t)k * n;
-            double s0 = 0, s1 = 0, s2 = 0;
-            for (size_t j = 0; j < n; ++j) {
-                const double *x = qc + 3 * (size_t)ctrl[j];
-                s0 += row[j] * x[0];
-                s1 += row[j] * x[1];
-                s2 += row[j] * x[2];
-            }
-            zi[k * 3 + 0] = s0;
-            zi[k * 3 + 1] = s1;
-            zi[k * 3 + 2] = s2;
-        }
-    }
-    int nth = o->nthreads;
-    double energy_total = 0;
-    int bad = 0;
-    double *thread_energy = calloc((size_t)nth, sizeof(double));
-    if (!thread_energy) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-#pragma omp parallel num_threads(nth) reduction(| : bad)
-    {
-        int t = omp_get_thread_num();
-        double *gz = o->grad_z_thread + (size_t)t * nz;
-        memset(gz, 0, nz * sizeof(double));
-        double energy = 0;
-        for (int c0 = 0; c0 < o->n_quad; c0 += o->chunk) {
-            int c1 = o->n_quad - c0 > o->chunk ? c0 + o->chunk : o->n_quad;
-            /* per point: F, psi, P, and N_p (static shares: deterministic for a fixed
-             * thread count) */
-#pragma omp for schedule(static)
-            for (int p = c0; p < c1; ++p) {
-                int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-                const double *D = o->point_D + (size_t)p * ma * 3;
-                double zb[27] = {0}; /* sum_i w_i z_i */
-                for (int r = r0; r < r1; ++r) {
-                    const double *zi = o->z + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
-                }
-                double F[9];
-                for (int dd = 0; dd < 3; ++dd)
-                    for (int e = 0; e < 3; ++e) {
-                        double f = 0;
-                        for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
-                        F[dd * 3 + e] = f;
-                    }
-                double P[9], H[81];
-                double vol = d->quad_volume[p];
-                double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
-                if (!isfinite(psi)) {
-                    bad = 1;
-                    if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
-                    continue;
-                }
-                energy += vol * psi;
-                /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
-                double v[27];
-                for (int k = 0; k < ma; ++k)
-                    for (int dd = 0; dd < 3; ++dd)
-                        v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
-                                               P[dd * 3 + 2] * D[k * 3 + 2]);
-                for (int r = r0; r < r1; ++r) {
-                    double *gzi = gz + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
-                }
-                if (!want_hessian) continue;
-                if (!o->exact_hessian) sem_project_psd_9x9(H);
-                point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
-            }
-            if (!want_hessian) continue;
-            /* per upper part pair: Kz_ab += sum_p w_a w_b N_p over the chunk's points, each
-             * pair summed by one thread in point order (deterministic for any thread count) */
-            int first = c0 == 0, last = c1 == o->n_quad;
-#pragma omp for schedule(dynamic, 8)
-            for (int pr = 0; pr < o->n_pairs; ++pr) {
-                if (!pair_has_points(o, pr)) continue;
-                double acc[378];
-                if (first) {
-                    memset(acc, 0, (size_t)np * sizeof(double));
-                    o->plist_cursor[pr] = o->plist_start[pr];
-                } else {
-                    memcpy(acc, o->Kz_packed + (size_t)pr * np, (size_t)np * sizeof(double));
-                }
-                int e0 = o->plist_cursor[pr], e1 = e0, end = o->plist_start[pr + 1];
-                while (e1 < end && o->plist_point[e1] < c1) e1++;
-                pair_sum(np, o->plist_point, o->plist_w, e0, e1, c0, o->N_chunk, acc);
-                o->plist_cursor[pr] = e1;
-                if (!last) {
-                    memcpy(o->Kz_packed + (size_t)pr * np, acc, (size_t)np * sizeof(double));
-                    continue;
-                }
-                /* full matrix, rows (k, d), columns (d', k') (see the projection below) */
-                double *K = o->Kz + (size_t)pr * bs;
-                int idx = 0;
-                for (int i = 0; i < n3; ++i) {
-                    int ri = (i % ma) * 3 + i / ma;
-                    for (int j = i; j < n3; ++j) {
-                        int rj = (j % ma) * 3 + j / ma;
-                        K[ri * n3 + j] = K[rj * n3 + i] = acc[idx++];
-                    }
-                }
-            }
-        }
-        thread_energy[t] = energy;
-    }
-    for (int t = 0; t < nth; ++t) energy_total += thread_energy[t];
-    free(thread_energy);
-    if (bad)
-        return sem_error_set(err, SEM_ERR_NUMERIC,
-                             "an element inverted or the state became non-finite (elastic energy "
-                             "undefined)");
-    o->elastic_energy = energy_total;
-    /* reduce in thread order */
-    memcpy(o->grad_z, o->grad_z_thread, nz * sizeof(double));
-    for (int t = 1; t < nth; ++t)
-        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_thread[(size_t)t * nz + k];
-    if (grad_q) {
-        memset(grad_q, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
-        for (int i = 0; i < o->n_parts; ++i) {
-            int g = d->part_origin[i];
-            size_t n = sem_group_size(o, g);
-            const int *ctrl = o->group_ctrl + o->group_start[g];
-            const double *gzi = o->grad_z + (size_t)i * ma * 3;
-            for (int k = 0; k < ma; ++k) {
-                const double *row = o->pi_shared[i] + (size_t)k * n;
-                for (size_t j = 0; j < n; ++j) {
-                    double *y = grad_q + 3 * (size_t)ctrl[j];
-                    y[0] += row[j] * gzi[k * 3 + 0];
-                    y[1] += row[j] * gzi[k * 3 + 1];
-                    y[2] += row[j] * gzi[k * 3 + 2];
-                }
-            }
-        }
-    }
-    if (!want_hessian) return SEM_OK;
-    /* K_q blocks = sum over part pairs Pi_a^T Kz Pi_b per coordinate pair. The small dgemm
-     * calls run inside our OpenMP threads: OpenBLAS's own threads would only oversubscribe
-     * the cores (measured: the rocket's step went from 18 ms to 11 ms), so BLAS is single
-     * threaded here and gets its threads back for the factorization. */
-    size_t mg = sem_max_group_size(o);
-    int fail = 0;
-    int blas_threads = openblas_get_num_threads();
-    double *val = fill ? sem_system_values(fill->system) : NULL;
-    openblas_set_num_threads(1);
-#pragma omp parallel num_threads(nth) reduction(| : fail)
-    {
-        /* Block(ga,gb) = sum_a Pi_a^T (sum_b Kz_ab Pi_b) with the shared-basis Pi: the inner
-         * sum first, so the expensive product with Pi_a^T is done once per part a, not per
-         * pair. Kz_ab (rows (k, d), columns (d', k')) is read as a (3ma x 3) x ma matrix,
-         * rows (k, d, d'), so the inner product is one call:
-         * U[(k,d,d')][j] = sum_k' Kz[(k,d),(d',k')] Pi_b[k'][j]; U is then an ma x 9|Gb|
-         * matrix, and Pi_a^T U is one call whose rows (la) hold the 9 sub-block rows side by
-         * side, the layout of K_blocks.
-         * Kz_ba = Kz_ab (symmetric) is stored once, under the pair a <= b. Pairs without a
-         * shared quadrature point (only in the error matrix's pattern) have no stiffness.
-         * K is symmetric, so only group pairs ga <= gb are formed (see setup_system). */
-        double *U = malloc(9 * (size_t)ma * mg * sizeof(double));
-        if (!U) fail = 1;
-#pragma omp for schedule(dynamic, 4)
-        for (int g = 0; g < o->n_gpairs; ++g) {
-            if (!U || o->gpair_a[g] > o->gpair_b[g]) continue;
-            int na = (int)sem_group_size(o, o->gpair_a[g]), nb = (int)sem_group_size(o, o->gpair_b[g]);
-            double *blk = o->K_blocks + 9 * o->gpair_offset[g];
-            int written = 0; /* the first product overwrites the block (no clearing pass) */
-            int k = o->gpair_pairs_start[g], end = o->gpair_pairs_start[g + 1];
-            while (k < end) {
-                int a = o->pair_a[o->gpair_pairs[k]];
-                int any = 0;
-                for (; k < end && o->pair_a[o->gpair_pairs[k]] == a; ++k) {
-                    int pr = o->gpair_pairs[k], b = o->pair_b[pr];
-                    int up = a <= b ? pr : o->pair_lookup[(size_t)b * o->n_parts + a];
-                    if (!pair_has_points(o, up)) continue;
-                    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, 3 * n3, nb, ma, 1.0,
-                                o->Kz + (size_t)up * bs, ma, o->pi_shared[b], nb, any ? 1.0 : 0.0, U, nb);
-                    any = 1;
-                }
-                if (!any) continue;
-                cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, 9 * nb, ma, 1.0, o->pi_shared[a], na,
-                            U, 9 * nb, written ? 1.0 : 0.0, blk, 9 * nb);
-                written = 1;
-            }
-            if (!written) memset(blk, 0, 9 * (size_t)na * nb * sizeof(double));
-            if (fill) sem_system_fill_gpair(fill->system, fill->object, g, fill->coef, val);
-        }
-        free(U);
-    }
-    openblas_set_num_threads(blas_threads);
-    if (fail) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    return SEM_OK;
-}
-
-/* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all dofs (block form). */
-static void blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
-                            const double *x, double *y)
-{
-    if (cK == 0 && cD == 0) {
-        /* mass and error matrix only: by rows in parallel */
-#pragma omp parallel for schedule(static) num_threads(o->nthreads)
-        for (int c = 0; c < o->n_ctrl; ++c) {
-            double y0 = 0, y1 = 0, y2 = 0;
-            for (int k = o->me_start[c]; k < o->me_start[c + 1]; ++k) {
-                double v = cM * o->me_M[k] + 2.0 * cE * o->me_E[k];
-                const double *xb = x + 3 * (size_t)o->me_col[k];
-                y0 += v * xb[0];
-                y1 += v * xb[1];
-                y2 += v * xb[2];
-            }
-            y[3 * (size_t)c + 0] = y0;
-            y[3 * (size_t)c + 1] = y1;
-            y[3 * (size_t)c + 2] = y2;
-        }
-        return;
-    }
-    memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
-    for (int g = 0; g < o->n_gpairs; ++g) {
-        int ga = o->gpair_a[g], gb = o->gpair_b[g];
-        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
-        size_t off = o->gpair_offset[g];
-        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
-        for (size_t la = 0; la < na; ++la) {
-            double *ya = y + 3 * (size_t)ca[la];
-            for (size_t lb = 0; lb < nb; ++lb) {
-                const double *xb = x + 3 * (size_t)cb[lb];
-                size_t e = la * nb + lb;
-                double s = cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
-                for (int d = 0; d < 3; ++d) ya[d] += s * xb[d];
-                if ((cK != 0 || cD != 0) && ga <= gb) {
-                    /* K is kept for ga <= gb; block (gb, ga) is its transpose */
-                    const double *xa = x + 3 * (size_t)ca[la];
-                    double *yb = y + 3 * (size_t)cb[lb];
-                    for (int d1 = 0; d1 < 3; ++d1)
-                        for (int d2 = 0; d2 < 3; ++d2) {
-                            size_t idx = 9 * off + (la * 9 + (size_t)(d1 * 3 + d2)) * nb + lb;
-                            double k = cK * o->K_blocks[idx] + cD * o->K0_blocks[idx];
-                            ya[d1] += k * xb[d2];
-                            if (ga < gb) yb[d2] += k * xa[d1];
-                        }
-                }
-            }
-        }
-    }
-}
-
-/* ---------------------------------------------------------------------------------- */
 /* steppers                                                                            */
 
 static int finite_vec(const double *x, size_t n)
@@ -1065,13 +358,13 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
     /* the system matrix's values are written as its K blocks are formed */
     sem_system *sys = o->system;
     const sem_fill_target fill = {sys, 0, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
-    if ((st = assemble_elastic(o, o->q, 1, g, sys->n_free > 0 ? &fill : NULL, err)) != SEM_OK) goto done;
+    if ((st = sem_assemble_elastic(o, o->q, 1, g, sys->n_free > 0 ? &fill : NULL, err)) != SEM_OK) goto done;
     sem_external_force(o, w->time, f);
     /* f_total = f_ext - grad V - 2 gamma M_eps q */
-    error_term(o, o->q, tmp);
+    sem_error_energy(o, o->q, tmp);
     for (size_t i = 0; i < n; ++i) f[i] -= g[i] + tmp[i];
     /* rhs = M v + h f - h C v ... damping enters the matrix: (M + hC + h^2K) v+ = M v + h f */
-    blocks_multiply(o, 1.0, 0, 0, 0, o->v, rhs);
+    sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, rhs);
     for (size_t i = 0; i < n; ++i) rhs[i] += h * f[i];
     /* prescribed velocities of pinned points */
     int any_pinned = 0;
@@ -1083,7 +376,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_object *o, sem_error 
         any_pinned = 1;
     }
     if (any_pinned) {
-        blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vp, tmp);
+        sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vp, tmp);
         for (size_t i = 0; i < n; ++i) rhs[i] -= tmp[i];
     }
     if (o->n_free > 0) {
@@ -1144,18 +437,18 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
 #define ENERGY(qq, out)                                                                    \
     do {                                                                                   \
         sem_error e_;                                                                      \
-        if (assemble_elastic(o, (qq), 0, NULL, NULL, &e_) != SEM_OK) {                          \
+        if (sem_assemble_elastic(o, (qq), 0, NULL, NULL, &e_) != SEM_OK) {                          \
             (out) = INFINITY;                                                              \
         } else {                                                                           \
-            double E_ = o->elastic_energy + error_term(o, (qq), tmp);                      \
+            double E_ = o->elastic_energy + sem_error_energy(o, (qq), tmp);                      \
             for (size_t i_ = 0; i_ < n; ++i_) E_ -= f[i_] * (qq)[i_];                      \
             if (dynamic) {                                                                 \
                 for (size_t i_ = 0; i_ < n; ++i_) dq[i_] = (qq)[i_] - qpred[i_];           \
-                blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);                       \
+                sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);                       \
                 for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * dq[i_] * tmp[i_];            \
                 if (cD > 0 || w->def.rayleigh_mass > 0) {                                  \
                     for (size_t i_ = 0; i_ < n; ++i_) dq[i_] = (qq)[i_] - qn[i_];          \
-                    blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);       \
+                    sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);       \
                     for (size_t i_ = 0; i_ < n; ++i_) E_ += 0.5 * dq[i_] * tmp[i_];        \
                 }                                                                          \
             }                                                                              \
@@ -1169,17 +462,17 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
     for (it = 0; it < w->def.newton_max_iterations; ++it) {
         /* the exact Hessian after two full steps in a row (see the file comment) */
         o->exact_hessian = exact_allowed && full_steps >= 2;
-        if ((st = assemble_elastic(o, o->q, 1, g, NULL, err)) != SEM_OK) goto done;
+        if ((st = sem_assemble_elastic(o, o->q, 1, g, NULL, err)) != SEM_OK) goto done;
         /* gradient: grad V + 2 gamma M_eps q - f + M (q - q_pred)/h^2 + damping */
-        error_term(o, o->q, tmp);
+        sem_error_energy(o, o->q, tmp);
         for (size_t i = 0; i < n; ++i) g[i] += tmp[i] - f[i];
         if (dynamic) {
             for (size_t i = 0; i < n; ++i) dq[i] = o->q[i] - qpred[i];
-            blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
+            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
             for (size_t i = 0; i < n; ++i) g[i] += tmp[i];
             if (cD > 0 || w->def.rayleigh_mass > 0) {
                 for (size_t i = 0; i < n; ++i) dq[i] = o->q[i] - qn[i];
-                blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);
+                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, cD, dq, tmp);
                 for (size_t i = 0; i < n; ++i) g[i] += tmp[i];
             }
         }
@@ -1202,7 +495,7 @@ static sem_status newton_solve(sem_world *w, sem_object *o, double h, double t1,
             o->exact_hessian = 0;
             exact_allowed = 0;
             w->counters.exact_hessian_fallbacks++;
-            if ((st = assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
+            if ((st = sem_assemble_elastic(o, o->q, 1, NULL, NULL, err)) != SEM_OK) goto done;
             sem_system_fill(o->system, cM, 1.0, 1.0, cD);
             st = sem_system_factorize(o->system, err);
             w->last_factor_s += sem_system_factor_seconds(o->system);
@@ -1385,11 +678,11 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
     if (o->mass > 0)
         for (int k = 0; k < 3; ++k) s->center_of_mass[k] /= o->mass;
     /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
-    blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
+    sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
     for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
-    s->error_energy = error_term(o, o->q, tmp);
+    s->error_energy = sem_error_energy(o, o->q, tmp);
     sem_error e;
-    if (assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK)
+    if (sem_assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK)
         s->elastic_energy = o->elastic_energy;
     else
         s->elastic_energy = INFINITY;
