@@ -1,5 +1,7 @@
 /*
- * world.h - the world: its settings, objects, clock and counters (internal to src/physics/).
+ * world.h - the world: its settings, objects, the systems a step solves, clock and
+ * counters (internal to src/physics/). Objects are numbered in the order they were added
+ * (the public API's object ids).
  */
 #ifndef SEM_PHYSICS_WORLD_H
 #define SEM_PHYSICS_WORLD_H
@@ -12,7 +14,8 @@ struct sem_world {
     sem_world_def def;
     int n_objects, cap;
     sem_object **objects;
-    sem_system **systems;      /* per object: the system it is solved in (owned) */
+    int n_systems;
+    sem_system **systems;      /* what a step solves: the objects, each in one system */
     double time;
     int step_index;
     double last_step_s, last_factor_s;
