@@ -42,6 +42,9 @@ typedef struct sem_world_advanced {
     int projected_hessian; /* 1: Newton keeps the PSD-projected Hessian throughout; 0: it
                               switches to the exact one once two steps in a row are full */
     int trace_newton;      /* 1: one log line per Newton iteration */
+    int solve_together;    /* 1: every object in one linear system (what contact will need;
+                              objects do not interact yet, so the motion is the same up to
+                              round-off and Newton's joint stopping test) */
 } sem_world_advanced;
 
 typedef struct sem_world_def {

@@ -164,7 +164,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         return -1;
     }
     sem_object *o = calloc(1, sizeof *o);
-    sem_system *sys = NULL;
+    sem_system *sys;
     if (!o) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         return -1;
@@ -234,7 +234,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->def.part_materials = NULL;
     if ((st = sem_loads_init(o, def, err)) != SEM_OK) goto fail;
     if ((st = sem_object_free_dofs(o, err)) != SEM_OK) goto fail;
-    /* error stiffness: the discretization's default is for its E; rescale to ours */
+    /* error stiffness: the object's, else the discretization's default */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
@@ -247,13 +247,11 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         goto fail;
     }
     if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
-    if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
     if ((st = sem_assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
     memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
     /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
     {
-        sem_object_stats s;
         double com[3] = {0, 0, 0};
         if (o->mass > 0) {
             double *xp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
@@ -267,7 +265,6 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
             for (int k = 0; k < 3; ++k) com[k] /= o->mass;
             free(xp);
         }
-        (void)s;
         const double *v0 = def->initial_velocity, *om = def->initial_angular_velocity;
         for (int c = 0; c < o->n_ctrl; ++c) {
             if (o->pinned[c]) continue;
@@ -290,11 +287,20 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         }
         w->cap = nc;
     }
+    /* its system: of its own, or (solve_together) the one system of every object, built
+     * again with the new one */
     w->objects[w->n_objects] = o;
-    w->systems[w->n_systems++] = sys;
+    if (w->def.advanced.solve_together && w->n_systems == 1) {
+        if ((st = sem_system_create(w->objects, w->n_objects + 1, w->def.solver, &sys, err)) != SEM_OK)
+            goto fail;
+        sem_system_destroy(w->systems[0]);
+        w->systems[0] = sys;
+    } else {
+        if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
+        w->systems[w->n_systems++] = sys;
+    }
     return w->n_objects++;
 fail:
-    sem_system_destroy(sys);
     object_destroy(o);
     return -1;
 }
