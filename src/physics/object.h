@@ -11,13 +11,24 @@
  * M_eps: the same for each coordinate) or 9 sub-blocks (d, d'), one per coordinate pair, at
  * 9 gpair_offset[g] (K). The layout is fixed when the object is added
  * (object_layout.c) and every other file works through it.
+ *
+ * Who fills what (the others only read it):
+ *   world.c          def, d, sizes, q, v, q0, materials, point_rho_vol, volume, mass,
+ *                    gamma, nthreads, the initial velocity, K0_blocks (K at rest)
+ *   loads.c          the definition's loads, pinned, prescriptions, f_gravity
+ *   object_layout.c  groups, part pairs, group pairs, block offsets, pi_dense
+ *   assembly.c       the shared basis, point lists, z-space work, K_blocks,
+ *                    elastic_energy, qc
+ *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
+ *                    n_orphans
+ *   system_layout.c  free_index, n_free, system
+ *   newton.c         exact_hessian (during a solve)
  */
 #ifndef SEM_PHYSICS_OBJECT_H
 #define SEM_PHYSICS_OBJECT_H
 
 #include <stddef.h>
 
-#include "linear_solver.h"
 #include "sem/simulation.h"
 
 struct sem_system;
