@@ -9,7 +9,7 @@
  * split the way the maths factors:
  *
  *   1. z-space (polynomial coefficients, m per part per coordinate, written in one basis
- *      b(X - ref) shared by all parts; see setup_stiffness): per point, the local 3x3
+ *      b(X - ref) shared by all parts; see setup_stiffness in assembly.c): per point, the 3x3
  *      deformation gradient, psi, P, d2psi/dF2 and its pull-back N_p to the shared basis;
  *      then per *part pair* the 3m x 3m block sum_p w_a w_b N_p.
  *   2. q-space: K_q = Pi^T K_z Pi. Pi_i's columns are exactly the control points of part
