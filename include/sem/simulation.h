@@ -33,6 +33,20 @@ typedef enum sem_solver_choice {
     SEM_SOLVER_DENSE   /* LAPACK dpotrf */
 } sem_solver_choice;
 
+/* Messages of a world: level 0 information (Newton's trace, when asked for), 1 warning. */
+typedef void (*sem_world_log_fn)(void *user, int level, const char *message);
+
+/* Settings for tests, studies and debugging; zero (the default) suits every other use. */
+typedef struct sem_world_advanced {
+    int assembly_chunk;    /* quadrature points per stiffness assembly chunk; <= 0: 8192 */
+    int projected_hessian; /* 1: Newton keeps the PSD-projected Hessian throughout; 0: it
+                              switches to the exact one once two steps in a row are full */
+    int trace_newton;      /* 1: one log line per Newton iteration */
+    int solve_together;    /* 1: every object in one linear system (what contact will need;
+                              objects do not interact yet, so the motion is the same up to
+                              round-off and Newton's joint stopping test) */
+} sem_world_advanced;
+
 typedef struct sem_world_def {
     double gravity[3];
     sem_integrator integrator;
@@ -42,6 +56,9 @@ typedef struct sem_world_def {
     int newton_max_iterations; /* default 50 (static: 200) */
     sem_solver_choice solver;
     int threads;               /* 0: OpenMP default */
+    sem_world_log_fn log;      /* may be NULL */
+    void *log_user;
+    sem_world_advanced advanced;
 } sem_world_def;
 
 sem_world_def sem_default_world_def(void);
@@ -137,6 +154,18 @@ const char *sem_world_solver_name(const sem_world *world, int object);
 double sem_world_object_nnz_percent(const sem_world *world, int object);
 /* Newton iterations of the last step (implicit/static). */
 int sem_world_last_iterations(const sem_world *world);
+
+/* What a world has done since it was created (as Box2D's b2World_GetCounters). */
+typedef struct sem_world_counters {
+    long steps;                   /* successful sem_world_step calls */
+    long newton_iterations;       /* Newton iterations of every step and static solve */
+    long factorizations;          /* system matrices factorized (an automatic solver choice
+                                     tries both solvers on the first one: counted once) */
+    long exact_hessian_fallbacks; /* Newton solves whose exact Hessian was not positive
+                                     definite, so that went back to the projected one */
+} sem_world_counters;
+
+sem_world_counters sem_world_get_counters(const sem_world *world);
 
 #ifdef __cplusplus
 }

@@ -113,12 +113,19 @@ class sem_object_stats(Structure):
                 ("linear_momentum", c_double * 3), ("angular_momentum", c_double * 3)]
 
 
+class sem_world_advanced(Structure):
+    _c_header_ = "simulation.h"
+    _fields_ = [("assembly_chunk", c_int), ("projected_hessian", c_int),
+                ("trace_newton", c_int), ("solve_together", c_int)]
+
+
 class sem_world_def(Structure):
     _c_header_ = "simulation.h"
     _fields_ = [("gravity", c_double * 3), ("integrator", c_int), ("dt", c_double),
                 ("rayleigh_mass", c_double), ("rayleigh_stiffness", c_double),
                 ("newton_tolerance", c_double), ("newton_max_iterations", c_int),
-                ("solver", c_int), ("threads", c_int)]
+                ("solver", c_int), ("threads", c_int), ("log", c_void_p),
+                ("log_user", c_void_p), ("advanced", sem_world_advanced)]
 
 
 class sem_curve(Structure):
@@ -217,7 +224,8 @@ class sem_scene_world_options(Structure):
                 ("log", sem_scene_log_fn), ("log_user", c_void_p)]
 
 
-MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_def,
+MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,
+                    sem_world_def,
                     sem_curve, sem_surface, sem_trim_loop, sem_part, sem_model,
                     sem_preprocess_options, sem_preprocess_timings, sem_csr,
                     sem_discretization, sem_scene, sem_scene_world_options]

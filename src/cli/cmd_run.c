@@ -193,6 +193,14 @@ static void run_log(void *user, int level, const char *message)
         fprintf(stderr, "sem: %s\n", message);
 }
 
+/* The world's log: Newton's trace (SEM_DEBUG_NEWTON) on stderr. */
+static void world_log(void *user, int level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "%s\n", message);
+}
+
 int cmd_run(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
@@ -230,6 +238,13 @@ int cmd_run(int argc, char **argv)
     if (st != SEM_OK) return cli_fail_error(NULL, &err);
     if (frames >= 0) r.scene->frames = frames;
     if (out_dir) snprintf(r.scene->output_dir, sizeof r.scene->output_dir, "%s", out_dir);
+    /* the library reads no environment: the command line turns SEM_DEBUG_NEWTON into the
+     * world's trace setting */
+    const char *trace = getenv("SEM_DEBUG_NEWTON");
+    if (trace && *trace && strcmp(trace, "0") != 0) {
+        r.scene->world.advanced.trace_newton = 1;
+        r.scene->world.log = world_log;
+    }
     if (!scene_path && !quiet) fprintf(stderr, "sem: no scene given; running the embedded default scene (%s)\n", "rubber beam clamped at x = 0");
     r.frames = cJSON_CreateArray();
     int rc = CLI_FAILED;
