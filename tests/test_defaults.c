@@ -90,6 +90,7 @@ static beam_result solve_beam(int sections, const double R[9], const sem_preproc
     od.model = m;
     od.disc = d;
     od.material = sem_default_material(); /* neo-Hookean, rho 1000, E 1e6, nu 0.45 */
+    if (opt && opt->origin_rule == SEM_ORIGINS_PAPER) od.blend = 0; /* the authors' settings */
     od.pinned = pin;
     if (!w || sem_world_add_object(w, &od, &err) < 0 || sem_world_solve_static(w, &err) != SEM_OK) {
         CHECK(0, "solve (%d sections): %s", sections, err.message);

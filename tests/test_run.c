@@ -148,8 +148,9 @@ static void test_default_scene(const char *tmp)
         CHECK(!strcmp(str(s, "status"), "ok"), "status %s", str(s, "status"));
         CHECK(cJSON_IsFalse(cJSON_GetObjectItemCaseSensitive(s, "preprocess_cached")), "first run preprocesses");
         /* beam 2 x 0.4 x 0.4 of density 1100; 18 biquadratic patches of 9 control points */
-        CHECK_REL(num(s, "volume"), 0.32, 1e-12);
-        CHECK_REL(num(s, "mass"), 352.0, 1e-12);
+        /* the default cells take their lengths from Embree's single-precision ray hits */
+        CHECK_REL(num(s, "volume"), 0.32, 1e-7);
+        CHECK_REL(num(s, "mass"), 352.0, 1e-7);
         CHECK(num(s, "dofs") == 3 * 18 * 9, "dofs %g", num(s, "dofs"));
         CHECK(num(s, "steps") == 4, "steps %g", num(s, "steps"));
         CHECK(num(s, "max_step_s") >= num(s, "mean_step_s") && num(s, "mean_step_s") > 0, "step times");
@@ -166,7 +167,7 @@ static void test_default_scene(const char *tmp)
             CHECK_NEAR(vec_n(f0, "center_of_mass", 0), 1.0, 1e-12);
             CHECK_NEAR(vec_n(f0, "center_of_mass", 1), 0.2, 1e-12);
             CHECK_NEAR(vec_n(f0, "center_of_mass", 2), 0.2, 1e-12);
-            CHECK_REL(num(f0, "gravity_energy"), 352.0 * 9.81 * 0.2, 1e-12);
+            CHECK_REL(num(f0, "gravity_energy"), 352.0 * 9.81 * 0.2, 1e-7);
             /* falling under gravity: the centre of mass drops, energy turns kinetic and elastic,
              * and the total does not grow (implicit Euler dissipates) */
             CHECK(vec_n(f2, "center_of_mass", 2) < 0.2 - 1e-3, "com z %g", vec_n(f2, "center_of_mass", 2));

@@ -3,7 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "physics/simulation_internal.h"
 #include "sem/material.h"
 #include "sem/preprocess.h"
 #include "sem/primitives.h"
@@ -389,10 +388,9 @@ static double *chunked_run(int chunk, size_t *n)
     od.initial_angular_velocity[0] = 2.0;
     od.initial_angular_velocity[2] = 3.0;
     od.material.youngs_modulus = 1e5;
-    sem_simulation_set_assembly_chunk(chunk);
+    wd.advanced.assembly_chunk = chunk;
     setup s;
     int ok = make_box_world(&s, 2, &wd, &od);
-    sem_simulation_set_assembly_chunk(0);
     sem_error err;
     for (int k = 0; k < 5 && ok; ++k) ok = sem_world_step(s.world, &err) == SEM_OK;
     double *q = NULL;
@@ -538,11 +536,163 @@ static void test_part_materials(void)
     CHECK_REL(m_dense, 2.0 * m_default, 1e-14);
 }
 
+/* Log callback of test_counters: counts Newton's trace lines. */
+static void count_lines(void *user, int level, const char *message)
+{
+    int *lines = user;
+    if (level == 0 && strncmp(message, "newton it ", 10) == 0) ++*lines;
+}
+
+/* The world's counters (sem_world_get_counters) and Newton's trace: the linearly implicit
+ * step factorizes once per step and runs no Newton iteration; Newton factorizes once per
+ * iteration plus once per fallback to the projected Hessian, and traces one line per
+ * iteration to the world's log; the trace changes no bit of the result. */
+static void test_counters(void)
+{
+    sem_error err;
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.81;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    wd.solver = SEM_SOLVER_SPARSE; /* the automatic choice is timed, so its bits may vary */
+    setup s;
+    if (make_box_world(&s, 2, &wd, NULL)) {
+        for (int k = 0; k < 3; ++k) CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
+        sem_world_counters c = sem_world_get_counters(s.world);
+        CHECK(c.steps == 3 && c.factorizations == 3 && c.newton_iterations == 0,
+              "linearly implicit: %ld steps, %ld factorizations, %ld Newton iterations", c.steps,
+              c.factorizations, c.newton_iterations);
+    }
+    setup_free(&s);
+    /* implicit Euler on a soft box, without and with the trace */
+    double *q[2] = {NULL, NULL};
+    size_t n = 0;
+    for (int trace = 0; trace < 2; ++trace) {
+        int lines = 0;
+        wd.integrator = SEM_IMPLICIT_EULER;
+        wd.log = count_lines;
+        wd.log_user = &lines;
+        wd.advanced.trace_newton = trace;
+        sem_object_def od = sem_default_object_def();
+        od.material.youngs_modulus = 1e5;
+        if (!make_box_world(&s, 2, &wd, &od)) {
+            setup_free(&s);
+            break;
+        }
+        long iterations = 0;
+        for (int k = 0; k < 3; ++k) {
+            CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
+            iterations += sem_world_last_iterations(s.world);
+        }
+        sem_world_counters c = sem_world_get_counters(s.world);
+        CHECK(c.steps == 3, "%ld steps", c.steps);
+        CHECK(c.newton_iterations == iterations && iterations >= 3,
+              "%ld Newton iterations counted, %ld reported by the steps", c.newton_iterations,
+              iterations);
+        CHECK(c.factorizations == c.newton_iterations + c.exact_hessian_fallbacks,
+              "%ld factorizations, %ld iterations, %ld fallbacks", c.factorizations,
+              c.newton_iterations, c.exact_hessian_fallbacks);
+        CHECK(lines == (trace ? iterations : 0), "trace %d: %d lines for %ld iterations", trace,
+              lines, iterations);
+        n = (size_t)sem_world_object_dofs(s.world, 0);
+        q[trace] = malloc(n * sizeof(double));
+        if (q[trace]) memcpy(q[trace], sem_world_object_q(s.world, 0), n * sizeof(double));
+        setup_free(&s);
+    }
+    if (q[0] && q[1]) CHECK(memcmp(q[0], q[1], n * sizeof(double)) == 0, "the trace changed the result");
+    free(q[0]);
+    free(q[1]);
+}
+
+/* Two objects in a world, each in its own system or both in one (advanced.solve_together,
+ * the layout contact will need): a falling, spinning box and a 2-section beam clamped at
+ * x = 0 sagging under gravity. The one system has both matrices as diagonal blocks, its
+ * free dofs numbered object after object (the beam's pinned points left out), so the
+ * motion must be the same up to round-off (linearly implicit Euler: one factorization per
+ * step instead of two) and up to Newton's joint stopping test (implicit Euler). Returns
+ * the largest difference of a control point between the two worlds, NaN on failure. */
+static double together_difference(sem_integrator integrator, int steps)
+{
+    setup box, beam;
+    int ok = make_model(&box, 0, 2, 4);
+    ok = make_model(&beam, 2, 2, 4) && ok;
+    size_t nc = ok ? sem_model_control_points(beam.model) : 0;
+    double *q0 = malloc(3 * nc * sizeof(double) + 1);
+    unsigned char *pin = calloc(nc + 1, 1);
+    sem_world *world[2] = {NULL, NULL};
+    double worst = NAN;
+    if (!ok || !q0 || !pin) goto done;
+    sem_model_get_q(beam.model, q0);
+    for (size_t c = 0; c < nc; ++c) pin[c] = fabs(q0[3 * c]) < 1e-9;
+    for (int together = 0; together < 2; ++together) {
+        sem_error err;
+        sem_world_def wd = sem_default_world_def();
+        wd.integrator = integrator;
+        wd.solver = SEM_SOLVER_SPARSE;
+        wd.advanced.solve_together = together;
+        world[together] = sem_world_create(&wd, &err);
+        sem_object_def od = sem_default_object_def();
+        od.model = box.model;
+        od.disc = box.disc;
+        od.material.youngs_modulus = 1e5;
+        od.initial_angular_velocity[1] = 2.0;
+        ok = world[together] && sem_world_add_object(world[together], &od, &err) == 0;
+        od = sem_default_object_def();
+        od.model = beam.model;
+        od.disc = beam.disc;
+        od.pinned = pin;
+        ok = ok && sem_world_add_object(world[together], &od, &err) == 1;
+        CHECK(ok, "together %d: %s", together, err.message);
+        for (int k = 0; k < steps && ok; ++k) {
+            ok = sem_world_step(world[together], &err) == SEM_OK;
+            CHECK(ok, "together %d, step %d: %s", together, k, err.message);
+        }
+        if (!ok) goto done;
+    }
+    sem_world_counters c[2] = {sem_world_get_counters(world[0]), sem_world_get_counters(world[1])};
+    if (integrator == SEM_LINEARLY_IMPLICIT_EULER)
+        CHECK(c[0].factorizations == 2 * steps && c[1].factorizations == steps,
+              "%ld factorizations apart, %ld together, %d steps", c[0].factorizations,
+              c[1].factorizations, steps);
+    CHECK(strcmp(sem_world_solver_name(world[1], 0), "cholmod") == 0 &&
+              strcmp(sem_world_solver_name(world[1], 1), "cholmod") == 0,
+          "solver names");
+    worst = 0;
+    for (int i = 0; i < 2; ++i) {
+        const double *qa = sem_world_object_q(world[0], i), *qb = sem_world_object_q(world[1], i);
+        for (int k = 0; k < sem_world_object_dofs(world[0], i); ++k) worst = fmax(worst, fabs(qa[k] - qb[k]));
+    }
+    /* the beam's clamped end stays put in the one system too */
+    const double *qb = sem_world_object_q(world[1], 1);
+    size_t moved = 0;
+    for (size_t c2 = 0; c2 < nc; ++c2) moved += pin[c2] && memcmp(qb + 3 * c2, q0 + 3 * c2, 3 * sizeof(double)) != 0;
+    CHECK(moved == 0, "%zu pinned points moved", moved);
+done:
+    sem_world_destroy(world[0]);
+    sem_world_destroy(world[1]);
+    free(q0);
+    free(pin);
+    setup_free(&box);
+    setup_free(&beam);
+    return worst;
+}
+
+static void test_solve_together(void)
+{
+    double linear = together_difference(SEM_LINEARLY_IMPLICIT_EULER, 5);
+    double newton = together_difference(SEM_IMPLICIT_EULER, 3);
+    printf("solved together: control points differ by %.3g m (linearly implicit), %.3g m "
+           "(implicit Euler)\n", linear, newton);
+    CHECK(linear <= 1e-10, "linearly implicit: %g m apart", linear);
+    CHECK(newton <= 1e-6, "implicit Euler: %g m apart", newton);
+}
+
 int main(void)
 {
     test_free_fall();
     test_part_materials();
     test_assembly_chunks();
+    test_counters();
+    test_solve_together();
     test_driven_rotation();
     test_rayleigh_momentum();
     test_momentum_and_spin();

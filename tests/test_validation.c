@@ -17,7 +17,6 @@
 
 #include "bench/validation.h"
 #include "preprocess/raycast.h"
-#include "physics/simulation_internal.h"
 #include "preprocess/steps.h"
 #include "sem/primitives.h"
 #include "test_util.h"
@@ -170,11 +169,9 @@ static void test_newton_hessian(void)
         sem_cantilever_result r[2];
         long fallbacks[2];
         for (int exact = 0; exact < 2; ++exact) {
-            int old = sem_simulation_set_exact_hessian(exact);
-            long before = sem_simulation_exact_hessian_fallbacks();
+            s.projected_hessian = !exact;
             sem_status st = sem_cantilever_solve(m, &s, &r[exact], &err);
-            fallbacks[exact] = sem_simulation_exact_hessian_fallbacks() - before;
-            sem_simulation_set_exact_hessian(old);
+            fallbacks[exact] = r[exact].exact_hessian_fallbacks;
             CHECK(st == SEM_OK, "gravity %g, exact %d: %s", gravity[c], exact, err.message);
             if (st != SEM_OK) {
                 sem_model_destroy(m);

@@ -1,16 +1,19 @@
 /*
  * sem/animation.h - animation output: per-frame NURBS (IGES, optionally OBJ free-form),
- * per-frame render meshes (OBJ), and one USD (usda) file of the whole animation with
- * time-sampled points, loadable in Blender and usdview.
+ * per-frame render meshes (OBJ), one USD (usda) file of the whole animation with
+ * time-sampled points, loadable in Blender and usdview, and one animated glTF binary
+ * (animation.glb: per-part materials, the motion as morph targets) for Blender, three.js
+ * and other glTF viewers.
  *
  * Each frame is written atomically (temp file, then rename), so a run that stops early
- * leaves every earlier frame complete on disk. The USD file is written by
+ * leaves every earlier frame complete on disk. The USD and glTF files are written by
  * sem_animation_finish, which a caller also calls after a failed step.
  */
 #ifndef SEM_ANIMATION_H
 #define SEM_ANIMATION_H
 
 #include "sem/model.h"
+#include "sem/preprocess.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -19,6 +22,7 @@ extern "C" {
 typedef struct sem_animation_def {
     const char *dir;         /* output folder (created if missing) */
     int write_iges, write_obj, write_mesh, write_usd;
+    int write_glb;           /* animation.glb */
     int mesh_resolution;     /* tessellation cells per knot span */
     double frames_per_second;
     /* The models are in metres. Frame files (NURBS and meshes) are written in frame_units
@@ -43,6 +47,15 @@ sem_status sem_animation_finish(sem_animation *anim, sem_error *err);
 void sem_animation_destroy(sem_animation *anim);
 /* Path of the USD file (valid after create). */
 const char *sem_animation_usd_path(const sem_animation *anim);
+/* Path of the glTF file (valid after create). */
+const char *sem_animation_glb_path(const sem_animation *anim);
+
+/* Writes DIR/preprocess_K.semdisc for object K: its discretization without the boundary
+ * samples and the simulation operators (J-hat, Gamma, Grad, M, M_eps): the quadrature
+ * points, blending weights, deformation origins and projection Pi that `sem render
+ * --color weights:P|origins|quadrature` shows (read with sem_discretization_load). */
+sem_status sem_animation_write_preprocess(const sem_animation *anim, int object,
+                                          const sem_discretization *d, sem_error *err);
 
 #ifdef __cplusplus
 }

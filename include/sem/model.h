@@ -105,7 +105,9 @@ void sem_model_get_q(const sem_model *model, double *q);
 void sem_model_set_q(sem_model *model, const double *q);
 
 /* ---- files ---- */
-/* Format by extension: .igs/.iges, .obj (free-form). */
+/* Format by extension (any case): .igs/.iges (IGES 5.3), .obj (free-form), .step/.stp
+ * (ISO 10303-21 through Open CASCADE; SEM_ERR_UNSUPPORTED when libsem was built without it,
+ * see sem_has_step() in sem/version.h). */
 sem_status sem_model_load(const char *path, sem_model **out, sem_error *err);
 sem_status sem_model_save(const sem_model *model, const char *path, sem_error *err);
 sem_status sem_iges_read(const char *path, sem_model **out, sem_error *err);
@@ -114,6 +116,12 @@ sem_status sem_iges_read_buffer(const char *name, const char *data, size_t len, 
 sem_status sem_iges_write(const sem_model *model, const char *path, sem_error *err);
 sem_status sem_obj_read(const char *path, sem_model **out, sem_error *err);
 sem_status sem_obj_write(const sem_model *model, const char *path, sem_error *err);
+/* STEP AP214 through Open CASCADE: every face of the file becomes one part (its surface as
+ * a NURBS, its wires as parameter-space trim loops; model-space edges without a
+ * parameter-space curve are projected into the face), lengths in the file's unit. Writing
+ * stores each part as a trimmed B-spline face in the model's unit. */
+sem_status sem_step_read(const char *path, sem_model **out, sem_error *err);
+sem_status sem_step_write(const sem_model *model, const char *path, sem_error *err);
 /* Tessellated triangle mesh with normals; `resolution` samples per knot span per direction. */
 sem_status sem_mesh_obj_write(const sem_model *model, const char *path, int resolution,
                               sem_error *err);

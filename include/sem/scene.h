@@ -52,6 +52,7 @@ typedef struct sem_scene_object {
     int n_part_materials;
     sem_scene_part_material *part_materials;
     sem_preprocess_options sem;
+    double blend;              /* sem.blend: sem_object_def.blend (default SEM_DEFAULT_BLEND) */
     int has_pin_box;
     double pin_box[6];
     int n_pin_parts;
@@ -78,6 +79,7 @@ typedef struct sem_scene {
     int steps_per_frame;
     char output_dir[4096];
     int write_iges, write_obj, write_mesh, write_usd;
+    int write_glb;           /* output.glb: animation.glb */
     int mesh_resolution;
 } sem_scene;
 
@@ -127,6 +129,8 @@ typedef struct sem_scene_world_options {
     int write_cache;        /* store new discretizations in cache_dir */
     sem_scene_log_fn log;   /* may be NULL */
     void *log_user;
+    int skip_modes;         /* 1: do not look for zero-energy modes (sem_world_object_modes;
+                               one factorization per object) */
 } sem_scene_world_options;
 
 sem_scene_world_options sem_default_scene_world_options(void);
@@ -151,6 +155,9 @@ const char *sem_scene_world_file_units(const sem_scene_world *sw, int object);
 double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object);
 /* 1 when every object's discretization came from the cache. */
 int sem_scene_world_all_cached(const sem_scene_world *sw);
+/* Zero-energy modes found in an object (sem_world_object_modes), -1 when not looked for;
+ * each one is also a warning in the log naming the parts that are not held. */
+int sem_scene_world_spurious_modes(const sem_scene_world *sw, int object);
 /* Wall time spent loading models and preprocessing (or reading the cache), seconds. */
 double sem_scene_world_preprocess_seconds(const sem_scene_world *sw);
 

@@ -33,6 +33,20 @@ typedef enum sem_solver_choice {
     SEM_SOLVER_DENSE   /* LAPACK dpotrf */
 } sem_solver_choice;
 
+/* Messages of a world: level 0 information (Newton's trace, when asked for), 1 warning. */
+typedef void (*sem_world_log_fn)(void *user, int level, const char *message);
+
+/* Settings for tests, studies and debugging; zero (the default) suits every other use. */
+typedef struct sem_world_advanced {
+    int assembly_chunk;    /* quadrature points per stiffness assembly chunk; <= 0: 8192 */
+    int projected_hessian; /* 1: Newton keeps the PSD-projected Hessian throughout; 0: it
+                              switches to the exact one once two steps in a row are full */
+    int trace_newton;      /* 1: one log line per Newton iteration */
+    int solve_together;    /* 1: every object in one linear system (what contact will need;
+                              objects do not interact yet, so the motion is the same up to
+                              round-off and Newton's joint stopping test) */
+} sem_world_advanced;
+
 typedef struct sem_world_def {
     double gravity[3];
     sem_integrator integrator;
@@ -42,6 +56,9 @@ typedef struct sem_world_def {
     int newton_max_iterations; /* default 50 (static: 200) */
     sem_solver_choice solver;
     int threads;               /* 0: OpenMP default */
+    sem_world_log_fn log;      /* may be NULL */
+    void *log_user;
+    sem_world_advanced advanced;
 } sem_world_def;
 
 sem_world_def sem_default_world_def(void);
@@ -83,6 +100,13 @@ typedef struct sem_object_def {
     const sem_material *part_materials;
     int n_part_materials;
     double gamma;                        /* error stiffness; <= 0: disc->gamma scaled by E */
+    /* Volume consistency stiffness c (dimensionless; sem_default_object_def: SEM_DEFAULT_BLEND,
+     * 0: none): adds c E / alpha^2 sum_p vol_p sum_i w_pi |P_i(X_p) - x(X_p)|^2, the spread of
+     * the overlapping parts' polynomials around the blended position at every quadrature point
+     * (alpha the weights' cut-off distance). It vanishes for every motion all parts agree on
+     * (rigid, affine), so it leaves the patch test and momentum alone; it stiffens the motions
+     * Eq. 15 leaves free (see docs/simulation.md, "Zero-energy modes"). */
+    double blend;
     const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
     sem_prescribe prescribe;             /* motion of every pinned point (all points when
                                             pinned is NULL), unless prescribe_group is given */
@@ -100,6 +124,9 @@ typedef struct sem_object_def {
     int n_region_loads;
 } sem_object_def;
 
+#define SEM_DEFAULT_BLEND 0.02
+
+/* Default material, blend SEM_DEFAULT_BLEND, everything else zero / NULL. */
 sem_object_def sem_default_object_def(void);
 
 typedef struct sem_world sem_world;
@@ -137,6 +164,37 @@ const char *sem_world_solver_name(const sem_world *world, int object);
 double sem_world_object_nnz_percent(const sem_world *world, int object);
 /* Newton iterations of the last step (implicit/static). */
 int sem_world_last_iterations(const sem_world *world);
+
+/* Zero-energy (spurious) modes of an object: motions of the free object, beyond the 6
+ * rigid ones, that its rest stiffness (elastic + error energy) does not resist. values are
+ * the lowest non-rigid eigenvalues of K x = lambda M x as lambda rho L^2 / E (L the
+ * preprocessing length scale): elastic modes are 1e-4 and up, spurious ones below
+ * SEM_SPURIOUS_MODE_TOLERANCE. spurious == n_values means at least that many. */
+#define SEM_SPURIOUS_MODE_TOLERANCE 1e-6
+#define SEM_MODES_MAX 8
+typedef struct sem_object_modes {
+    int spurious;
+    int n_values;
+    double values[SEM_MODES_MAX];
+    int converged;                /* 1: the iteration met its tolerance */
+} sem_object_modes;
+/* Computes them (one factorization of the object's matrix with every point free, and a
+ * subspace iteration: about the cost of a few steps). part_flags (n_parts, may be NULL)
+ * receives 1 for each part that moves in a spurious mode (a part not held). */
+sem_status sem_world_object_modes(sem_world *world, int object, sem_object_modes *out, int *part_flags,
+                                  sem_error *err);
+
+/* What a world has done since it was created (as Box2D's b2World_GetCounters). */
+typedef struct sem_world_counters {
+    long steps;                   /* successful sem_world_step calls */
+    long newton_iterations;       /* Newton iterations of every step and static solve */
+    long factorizations;          /* system matrices factorized (an automatic solver choice
+                                     tries both solvers on the first one: counted once) */
+    long exact_hessian_fallbacks; /* Newton solves whose exact Hessian was not positive
+                                     definite, so that went back to the projected one */
+} sem_world_counters;
+
+sem_world_counters sem_world_get_counters(const sem_world *world);
 
 #ifdef __cplusplus
 }

@@ -40,6 +40,12 @@ typedef struct sem_mesh_template sem_mesh_template;
  * and direction. Fails when a trim loop does not close (message names the part). */
 sem_status sem_mesh_template_build(const sem_model *model, int resolution,
                                    sem_mesh_template **out, sem_error *err);
+/* The same, but a trimmed part keeps every triangle that reaches into its trimmed domain
+ * (a corner, an edge midpoint or the centroid inside): the mesh covers the domain and
+ * overhangs the trim curves by up to one cell, for a renderer that cuts them exactly at
+ * each hit's (u,v) with sem_trim_region_inside (sem/render.h). */
+sem_status sem_mesh_template_build_covering(const sem_model *model, int resolution,
+                                            sem_mesh_template **out, sem_error *err);
 void sem_mesh_template_destroy(sem_mesh_template *tmpl);
 
 /* Allocates mesh arrays and fills the topology (triangles, uv, parts); positions and

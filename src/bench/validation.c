@@ -42,6 +42,8 @@ sem_cantilever_settings sem_default_cantilever_settings(void)
     s.poisson_ratio = 0.45;
     s.gravity = 10.0;
     s.threads = 0;
+    s.projected_hessian = 0;
+    s.blend = 0.0;
     return s;
 }
 
@@ -155,6 +157,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     wd.gravity[2] = -s->gravity;
     wd.integrator = SEM_STATIC;
     wd.threads = s->threads;
+    wd.advanced.projected_hessian = s->projected_hessian;
     w = sem_world_create(&wd, err);
     if (!w) {
         st = err ? err->status : SEM_ERR_INVALID;
@@ -165,6 +168,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     od.disc = d;
     if ((st = sem_cantilever_material(s, &od.material, err)) != SEM_OK) goto done;
     od.gamma = s->gamma;
+    od.blend = s->blend;
     od.pinned = pin;
     if (sem_world_add_object(w, &od, err) < 0) {
         st = err ? err->status : SEM_ERR_INVALID;
@@ -179,6 +183,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     out->volume = d->volume;
     out->tip_deflection = sem_cantilever_tip(model, q0, sem_world_object_q(w, 0));
     out->newton_iterations = sem_world_last_iterations(w);
+    out->exact_hessian_fallbacks = sem_world_get_counters(w).exact_hessian_fallbacks;
     out->preprocess_s = t1 - t0;
     out->solve_s = t2 - t1;
 done:

@@ -22,10 +22,12 @@ typedef struct sem_cantilever_settings {
     int points_per_interval; /* 100 */
     double alpha;            /* 0.501 */
     double gamma;            /* error stiffness; <= 0: the preprocessing default (kappa E / L) */
+    double blend;            /* sem_object_def.blend; 0: none, as in the paper */
     sem_material_type material; /* neo-Hookean (the paper's) */
     double density, youngs_modulus, poisson_ratio; /* 1000, 1e6, 0.45 */
     double gravity;          /* 10 m/s^2 along -z */
     int threads;             /* 0: OpenMP default */
+    int projected_hessian;   /* 1: Newton without the exact-Hessian switch (sem_world_advanced) */
 } sem_cantilever_settings;
 
 sem_cantilever_settings sem_default_cantilever_settings(void);
@@ -35,6 +37,7 @@ typedef struct sem_cantilever_result {
     double volume;
     double tip_deflection;   /* mean -u_z of the free end cap's control points, m */
     int newton_iterations;
+    long exact_hessian_fallbacks; /* the world's counter (sem_world_get_counters) */
     double preprocess_s, solve_s;
 } sem_cantilever_result;
 

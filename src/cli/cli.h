@@ -31,6 +31,8 @@ int cmd_convert(int argc, char **argv);
 int cmd_preprocess(int argc, char **argv);
 int cmd_run(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_view(int argc, char **argv);
 
 /* ---- messages (main.c) ---- */
 /* Prints "sem: <message>" on stderr; returns CLI_FAILED. */

@@ -71,6 +71,7 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     sem_object_def od = sem_default_object_def();
     od.model = m;
     od.disc = d;
+    od.blend = 0; /* the authors' discretization */
     od.material.density = r->density;
     od.material.youngs_modulus = r->youngs_modulus;
     od.material.poisson_ratio = r->poisson_ratio;

@@ -1,6 +1,6 @@
 /*
  * cmd_convert.c - `sem convert IN OUT`: read any model format sem_model_load knows and
- * write it in the format of OUT's extension (IGES <-> OBJ free-form).
+ * write it in the format of OUT's extension (IGES, OBJ free-form, STEP).
  */
 #include <stdio.h>
 #include <string.h>

@@ -9,10 +9,12 @@
  */
 #include <omp.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
 #include "sem/preprocess.h"
+#include "sem/simulation.h"
 
 #define CMD "preprocess"
 
@@ -61,6 +63,39 @@ static cJSON *to_json(const sem_discretization *d, double total_s)
     return j;
 }
 
+/* Zero-energy modes of the free object with the default material at E (and the default
+ * blend): a throw-away world with the model as its only object. */
+static sem_status find_modes(const sem_model *model, const sem_discretization *d, double E, double blend,
+                             sem_object_modes *m, int *flags, sem_error *err)
+{
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[0] = wd.gravity[1] = wd.gravity[2] = 0;
+    sem_world *w = sem_world_create(&wd, err);
+    if (!w) return err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
+    sem_object_def od = sem_default_object_def();
+    od.model = model;
+    od.disc = d;
+    od.material.youngs_modulus = E;
+    od.blend = blend;
+    sem_status st = sem_material_init(&od.material, err);
+    int id = st == SEM_OK ? sem_world_add_object(w, &od, err) : -1;
+    if (st == SEM_OK && id < 0) st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
+    if (st == SEM_OK) st = sem_world_object_modes(w, id, m, flags, err);
+    sem_world_destroy(w);
+    return st;
+}
+
+static void add_modes_json(cJSON *j, const sem_object_modes *m, const int *flags, int n_parts)
+{
+    cJSON_AddNumberToObject(j, "spurious_modes", m->spurious);
+    cJSON *v = cJSON_AddArrayToObject(j, "lowest_modes");
+    for (int k = 0; k < m->n_values; ++k) cJSON_AddItemToArray(v, cJSON_CreateNumber(m->values[k]));
+    cJSON_AddBoolToObject(j, "modes_converged", m->converged);
+    cJSON *p = cJSON_AddArrayToObject(j, "parts_not_held");
+    for (int i = 0; i < n_parts; ++i)
+        if (flags[i]) cJSON_AddItemToArray(p, cJSON_CreateNumber(i));
+}
+
 static void print_human(const char *path, const sem_discretization *d, double total_s)
 {
     printf("%s\n", path);
@@ -85,14 +120,20 @@ static void print_human(const char *path, const sem_discretization *d, double to
 int cmd_preprocess(int argc, char **argv)
 {
     const char *path = NULL, *save = NULL;
-    int json = 0, have_alpha = 0, have_sparsity = 0;
-    double alpha = 0, sparsity = 0;
+    int json = 0, have_alpha = 0, have_sparsity = 0, modes = 1;
+    double alpha = 0, sparsity = 0, blend = SEM_DEFAULT_BLEND;
     sem_preprocess_options o = sem_default_preprocess_options();
     int rc = CLI_OK;
     for (int i = 1; i < argc && rc == CLI_OK; ++i) {
         const char *a = argv[i];
         if (strcmp(a, "--json") == 0) {
             json = 1;
+        } else if (strcmp(a, "--no-modes") == 0) {
+            modes = 0;
+        } else if (strcmp(a, "--blend") == 0) {
+            if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
+            rc = cli_parse_double(CMD, a, argv[++i], &blend);
+            if (rc == CLI_OK && !(blend >= 0 && blend <= 1e6)) rc = cli_fail("--blend must be in 0..1e6 (got %g)", blend);
         } else if (strcmp(a, "--order") == 0) {
             if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
             rc = cli_parse_int(CMD, a, argv[++i], &o.order);
@@ -170,19 +211,45 @@ int cmd_preprocess(int argc, char **argv)
     double t0 = omp_get_wtime();
     sem_status st = sem_preprocess(model, &o, &d, &err);
     double total_s = omp_get_wtime() - t0;
+    if (st != SEM_OK) {
+        sem_model_destroy(model);
+        return cli_fail_error(path, &err);
+    }
+    sem_object_modes m;
+    int *flags = calloc((size_t)d->n_parts + 1, sizeof *flags);
+    if (!flags) st = sem_error_set(&err, SEM_ERR_NOMEM, "out of memory");
+    if (st == SEM_OK && modes) st = find_modes(model, d, o.youngs_modulus, blend, &m, flags, &err);
     sem_model_destroy(model);
-    if (st != SEM_OK) return cli_fail_error(path, &err);
+    if (st != SEM_OK) {
+        free(flags);
+        sem_discretization_destroy(d);
+        return cli_fail_error(path, &err);
+    }
 
     if (save && sem_discretization_save(d, save, &err) != SEM_OK) {
+        free(flags);
         sem_discretization_destroy(d);
         return cli_fail_error(save, &err);
     }
     if (json) {
-        rc = cli_print_json(to_json(d, total_s));
+        cJSON *j = to_json(d, total_s);
+        if (modes) add_modes_json(j, &m, flags, d->n_parts);
+        rc = cli_print_json(j);
     } else {
         print_human(path, d, total_s);
+        if (modes) {
+            printf("  zero-energy modes     %d%s (lowest elastic mode %.3g E / (rho L^2))\n", m.spurious,
+                   m.spurious == m.n_values ? " or more" : "", m.n_values > m.spurious ? m.values[m.spurious] : 0.0);
+            if (m.spurious > 0) {
+                printf("  parts not held       ");
+                for (int i = 0; i < d->n_parts; ++i)
+                    if (flags[i]) printf(" %d", i);
+                printf("\n");
+            }
+        }
         if (save) printf("  saved                 %s\n", save);
     }
+    free(flags);
     sem_discretization_destroy(d);
     return rc;
 }

@@ -87,6 +87,26 @@ static void add_frame_stats(run_state *r, double t)
     cJSON_AddItemToArray(r->frames, f);
 }
 
+/* What `sem render` needs to know about object i beside its frames (docs/render.md): its
+ * preprocessing file and each part's material (-1: the object's own, k: part_materials[k]). */
+static void add_render_info(run_state *r, int i, cJSON *o)
+{
+    char name[64];
+    snprintf(name, sizeof name, "preprocess_%d.semdisc", i);
+    cJSON_AddStringToObject(o, "preprocess_file", name);
+    int *part_material = NULL;
+    sem_material *materials = NULL;
+    sem_error err;
+    const sem_model *model = sem_scene_world_model(r->sw, i);
+    if (sem_scene_object_part_materials(&r->scene->objects[i], model, &part_material, &materials, &err) != SEM_OK)
+        return;
+    cJSON *list = cJSON_AddArrayToObject(o, "part_material");
+    for (int p = 0; p < model->n_parts && list; ++p)
+        cJSON_AddItemToArray(list, cJSON_CreateNumber(part_material ? part_material[p] : -1));
+    free(part_material);
+    free(materials);
+}
+
 static cJSON *summary(run_state *r, const char *status, const char *error)
 {
     cJSON *s = cJSON_CreateObject();
@@ -109,6 +129,7 @@ static cJSON *summary(run_state *r, const char *status, const char *error)
         cJSON_AddNumberToObject(o, "nnz_percent", sem_world_object_nnz_percent(r->world, i));
         cJSON_AddStringToObject(o, "file_units", sem_scene_world_file_units(r->sw, i));
         cJSON_AddNumberToObject(o, "file_unit_to_meter", sem_scene_world_file_unit_to_meter(r->sw, i));
+        add_render_info(r, i, o);
         cJSON_AddItemToArray(objs, o);
     }
     cJSON_AddStringToObject(s, "status", status);
@@ -129,6 +150,8 @@ static cJSON *summary(run_state *r, const char *status, const char *error)
     cJSON_AddBoolToObject(s, "preprocess_cached", sem_scene_world_all_cached(r->sw));
     cJSON_AddStringToObject(s, "output_dir", r->scene->output_dir);
     if (r->anim && r->scene->write_usd) cJSON_AddStringToObject(s, "usd", sem_animation_usd_path(r->anim));
+    if (r->anim && r->scene->write_glb) cJSON_AddStringToObject(s, "glb", sem_animation_glb_path(r->anim));
+    cJSON_AddNumberToObject(s, "frames_per_second", 1.0 / (r->scene->world.dt * r->scene->steps_per_frame));
     cJSON_AddItemToObject(s, "objects", objs);
     cJSON_AddItemReferenceToObject(s, "frames", r->frames);
     return s;
@@ -176,6 +199,14 @@ static void run_log(void *user, int level, const char *message)
         fprintf(stderr, "sem: %s\n", message);
 }
 
+/* The world's log: Newton's trace (SEM_DEBUG_NEWTON) on stderr. */
+static void world_log(void *user, int level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "%s\n", message);
+}
+
 int cmd_run(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
@@ -213,6 +244,13 @@ int cmd_run(int argc, char **argv)
     if (st != SEM_OK) return cli_fail_error(NULL, &err);
     if (frames >= 0) r.scene->frames = frames;
     if (out_dir) snprintf(r.scene->output_dir, sizeof r.scene->output_dir, "%s", out_dir);
+    /* the library reads no environment: the command line turns SEM_DEBUG_NEWTON into the
+     * world's trace setting */
+    const char *trace = getenv("SEM_DEBUG_NEWTON");
+    if (trace && *trace && strcmp(trace, "0") != 0) {
+        r.scene->world.advanced.trace_newton = 1;
+        r.scene->world.log = world_log;
+    }
     if (!scene_path && !quiet) fprintf(stderr, "sem: no scene given; running the embedded default scene (%s)\n", "rubber beam clamped at x = 0");
     r.frames = cJSON_CreateArray();
     int rc = CLI_FAILED;
@@ -247,6 +285,7 @@ int cmd_run(int argc, char **argv)
     ad.write_obj = r.scene->write_obj;
     ad.write_mesh = r.scene->write_mesh;
     ad.write_usd = r.scene->write_usd;
+    ad.write_glb = r.scene->write_glb;
     ad.mesh_resolution = r.scene->mesh_resolution;
     ad.frames_per_second = 1.0 / (r.scene->world.dt * r.scene->steps_per_frame);
     /* frames in the first object's file units (one unit per frame file) */
@@ -254,6 +293,8 @@ int cmd_run(int argc, char **argv)
     ad.frame_unit_to_meter = sem_scene_world_file_unit_to_meter(r.sw, 0);
     st = sem_animation_create(&ad, r.n, models, &r.anim, &err);
     free(models);
+    for (int i = 0; i < r.n && st == SEM_OK; ++i)
+        st = sem_animation_write_preprocess(r.anim, i, sem_scene_world_discretization(r.sw, i), &err);
     if (st != SEM_OK) {
         cli_fail_error(NULL, &err);
         goto done;
@@ -316,8 +357,9 @@ int cmd_run(int argc, char **argv)
         fprintf(stderr,
                 "sem: animation written to %s/: frame_NNNN.igs (NURBS for Rhino/Fusion 360), "
                 "frame_NNNN_mesh.obj (render meshes), animation.usda (open with Blender: File > Import > "
-                "Universal Scene Description, or usdview), summary.json\n",
-                r.scene->output_dir);
+                "Universal Scene Description, or usdview), animation.glb (glTF: Blender, three.js), summary.json; "
+                "to look at it: sem render %s --mp4 %s/anim.mp4, or sem view %s\n",
+                r.scene->output_dir, r.scene->output_dir, r.scene->output_dir, r.scene->output_dir);
     }
     rc = CLI_OK;
 done:

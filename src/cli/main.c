@@ -16,10 +16,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-
-#ifndef SEM_VERSION_STRING
-#define SEM_VERSION_STRING "unknown"
-#endif
+#include "sem/version.h"
 
 typedef struct cli_command {
     const char *name;
@@ -41,13 +38,14 @@ static const cli_command commands[] = {
      "  sphere    --radius R (1)  --center X Y Z\n"
      "  cylinder  --radius R (1)  --height H (2)  --center X Y Z   (axis z, closed)\n"
      "  torus     --major R (1)  --minor r (0.25)  --center X Y Z   (axis z)\n"
-     "  -o, --output FILE   where to write (.igs/.iges, .obj)\n"},
+     "  -o, --output FILE   where to write (.igs/.iges, .obj, .step/.stp)\n"},
     {"inspect", cmd_inspect, "FILE [--json]",
      "sizes, degrees of freedom, area, bounding box and warnings of a model",
      "  --json   print one JSON object (file, parts, control_points, dofs, trimmed_parts,\n"
      "           bbox, area, units, warnings, part_details) instead of text\n"},
     {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
-     "  IN and OUT: .igs/.iges or .obj\n"},
+     "  IN and OUT: .igs/.iges (IGES 5.3), .obj (OBJ free-form), .step/.stp (STEP, through\n"
+     "  Open CASCADE; `sem --version` says when this build has no STEP support)\n"},
     {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (40 40) across --axis (x)  --points-per-interval N (2)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (16)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n"},
     {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--quiet]",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
@@ -59,6 +57,29 @@ static const cli_command commands[] = {
      "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
      "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
     {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (5)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
+    {"render", cmd_render, "OUT_DIR | MODEL_FILE [-o OUT] [--mp4 FILE] [--size W H] [--frames A:B] [--camera AZ,EL[,DIST] | --camera EX,EY,EZ,TX,TY,TZ] [--color part|material|weights:PART|origins|quadrature]",
+     "ray-traced pictures of a run's frames (PNG, optionally an MP4 video) or of a model at rest",
+     "  OUT_DIR      a folder written by sem run: every frame -> OUT_DIR/render/frame_NNNN.png\n"
+     "  MODEL_FILE   a model (.igs/.iges, .obj): one picture of it at rest (default MODEL.png)\n"
+     "  -o OUT       the pictures' folder (a run) or the picture's file (a model)\n"
+     "  --mp4 FILE   also encode the frames as an H.264 video with ffmpeg\n"
+     "  --size W H   picture size in pixels (1280 720)\n"
+     "  --frames A:B only frames A..B (A:, :B and A also work)\n"
+     "  --camera AZ,EL[,DIST]       orbit camera: azimuth and elevation in degrees (-60,25), distance\n"
+     "                              (default: the whole animation fills the picture)\n"
+     "  --camera EX,EY,EZ,TX,TY,TZ  look-at camera: eye and target points\n"
+     "  --color MODE part (default), material, weights:PART (blending weights of one part),\n"
+     "               origins (deformation origins), quadrature (volume quadrature points)\n"
+     "  --disc FILE  preprocessed data for a model's diagnostic colours (sem preprocess --save);\n"
+     "               without it the model is preprocessed with the default settings\n"
+     "  --resolution N  tessellation cells per knot span (8)   --quiet  no progress output\n"},
+    {"view", cmd_view, "OUT_DIR [-o FILE]",
+     "write OUT_DIR/viewer.html: the animation in the browser (offline, self-contained)",
+     "  OUT_DIR   a folder written by sem run (needs its animation.glb; summary.json gives the\n"
+     "            energy plot)\n"
+     "  -o FILE   write the page there instead of OUT_DIR/viewer.html\n"
+     "  The page bundles three.js from the Debian package libjs-three\n"
+     "  (/usr/share/javascript/three; SEM_THREE_DIR overrides the folder).\n"},
 };
 
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
@@ -188,7 +209,7 @@ static void print_help(FILE *f)
             "       sem --version\n"
             "\n"
             "commands:\n",
-            SEM_VERSION_STRING);
+            sem_version());
     for (int i = 0; i < n_commands; ++i)
         fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 }
@@ -247,7 +268,7 @@ int main(int argc, char **argv)
         return CLI_OK;
     }
     if (strcmp(name, "--version") == 0 || strcmp(name, "version") == 0) {
-        printf("sem %s\n", SEM_VERSION_STRING);
+        printf("sem %s%s\n", sem_version(), sem_has_step() ? "" : " (without STEP: built without Open CASCADE)");
         return CLI_OK;
     }
     const cli_command *c = find_command(name);

@@ -104,10 +104,26 @@ static void part_topology_free(part_topology *pt)
     memset(pt, 0, sizeof *pt);
 }
 
+/* Does a triangle (3 sample nodes) reach into the trimmed domain: a corner, an edge
+ * midpoint or the centroid inside? */
+static int reaches_inside(const sem_trim_region *region, const part_topology *pt, const int node[3])
+{
+    double u[3], v[3];
+    for (int k = 0; k < 3; ++k) {
+        u[k] = pt->us[node[k] % pt->nu];
+        v[k] = pt->vs[node[k] / pt->nu];
+        if (sem_trim_region_inside(region, u[k], v[k])) return 1;
+    }
+    for (int k = 0; k < 3; ++k)
+        if (sem_trim_region_inside(region, 0.5 * (u[k] + u[(k + 1) % 3]), 0.5 * (v[k] + v[(k + 1) % 3])))
+            return 1;
+    return sem_trim_region_inside(region, (u[0] + u[1] + u[2]) / 3.0, (v[0] + v[1] + v[2]) / 3.0);
+}
+
 /* Samples and kept triangles of one part. The triangle and vertex numbering (cells in
  * row-major order, vertices numbered when first used) is the same for any thread count. */
 static void part_topology_build(const sem_part *part, int part_index, int resolution,
-                                part_topology *pt)
+                                int covering, part_topology *pt)
 {
     const sem_surface *s = &part->surface;
     sem_error *err = &pt->err;
@@ -156,13 +172,15 @@ static void part_topology_build(const sem_part *part, int part_index, int resolu
             int a = i + nu * j, b = a + 1, c = b + nu, d = a + nu;
             int tri[2][3] = {{a, b, c}, {a, c, d}};
             for (int h = 0; h < 2; ++h) {
-                if (region) {
+                if (region && !covering) {
                     double cu = 0, cv = 0;
                     for (int k = 0; k < 3; ++k) {
                         cu += pt->us[tri[h][k] % nu];
                         cv += pt->vs[tri[h][k] / nu];
                     }
                     if (!sem_trim_region_inside(region, cu / 3.0, cv / 3.0)) continue;
+                } else if (region && !reaches_inside(region, pt, tri[h])) {
+                    continue;
                 }
                 for (int k = 0; k < 3; ++k) {
                     int n = tri[h][k];
@@ -243,14 +261,15 @@ static void vertex_frame(const sem_surface *s, int n_basis, const int *index, co
 }
 
 /* Topology of every part, in parallel over parts; first error in part order. */
-static sem_status build_topologies(const sem_model *model, int resolution, part_topology **out,
-                                   sem_error *err)
+static sem_status build_topologies(const sem_model *model, int resolution, int covering,
+                                   part_topology **out, sem_error *err)
 {
     int n_parts = model->n_parts;
     part_topology *tp = calloc((size_t)(n_parts > 0 ? n_parts : 1), sizeof *tp);
     if (!tp) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
 #pragma omp parallel for schedule(dynamic, 1) if (n_parts > 1)
-    for (int i = 0; i < n_parts; ++i) part_topology_build(&model->parts[i], i, resolution, &tp[i]);
+    for (int i = 0; i < n_parts; ++i)
+        part_topology_build(&model->parts[i], i, resolution, covering, &tp[i]);
     for (int i = 0; i < n_parts; ++i)
         if (tp[i].status != SEM_OK) {
             if (err) *err = tp[i].err;
@@ -397,7 +416,8 @@ static sem_status check_model(const sem_model *model, int resolution, sem_error 
 /* Template topology (and, unless skip_basis, its basis rows); *tp_out keeps the part
  * topologies when non-NULL. */
 static sem_status template_build(const sem_model *model, int resolution, int skip_basis,
-                                 sem_mesh_template **out, part_topology **tp_out, sem_error *err)
+                                 int covering, sem_mesh_template **out, part_topology **tp_out,
+                                 sem_error *err)
 {
     *out = NULL;
     sem_status st = check_model(model, resolution, err);
@@ -411,7 +431,7 @@ static sem_status template_build(const sem_model *model, int resolution, int ski
         return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     }
     part_topology *tp = NULL;
-    st = build_topologies(model, resolution, &tp, err);
+    st = build_topologies(model, resolution, covering, &tp, err);
     if (st == SEM_OK) st = place_topologies(t, model, tp, err);
     if (st == SEM_OK && !skip_basis) {
         size_t nbasis = 0;
@@ -442,7 +462,13 @@ static sem_status template_build(const sem_model *model, int resolution, int ski
 sem_status sem_mesh_template_build(const sem_model *model, int resolution,
                                    sem_mesh_template **out, sem_error *err)
 {
-    return template_build(model, resolution, 0, out, NULL, err);
+    return template_build(model, resolution, 0, 0, out, NULL, err);
+}
+
+sem_status sem_mesh_template_build_covering(const sem_model *model, int resolution,
+                                            sem_mesh_template **out, sem_error *err)
+{
+    return template_build(model, resolution, 0, 1, out, NULL, err);
 }
 
 void sem_mesh_free(sem_mesh *m)
@@ -531,7 +557,7 @@ sem_status sem_mesh_from_model(const sem_model *model, int resolution, sem_mesh 
     memset(out, 0, sizeof *out);
     sem_mesh_template *t;
     part_topology *tp = NULL;
-    sem_status st = template_build(model, resolution, 1, &t, &tp, err);
+    sem_status st = template_build(model, resolution, 1, 0, &t, &tp, err);
     if (st != SEM_OK) return st;
     st = sem_mesh_template_mesh(t, out, err);
     if (st == SEM_OK) st = evaluate_parts(t, model, tp, out, err);

@@ -6,7 +6,7 @@
  * The data goes to "path.tmp.XXXXXX" in the same folder (same file system, so the final
  * rename is atomic), is flushed and fsync'ed, then renamed over path. On any failure the
  * temporary file is removed and path is left untouched.
- * Implemented in model_io.c.
+ * Implemented in atomic_file.c.
  */
 #ifndef SEM_IO_ATOMIC_FILE_H
 #define SEM_IO_ATOMIC_FILE_H

@@ -30,6 +30,12 @@
  * splines 112/114, conics, offset and analytic 190-198 surfaces, ...) are skipped with a
  * warning naming them, and a trim loop that cannot be built leaves its part untrimmed with
  * a warning rather than losing the part.
+ *
+ * Boundaries given in model space only (141 type 0 without parameter-space curves, 508
+ * edges whose 504 curve has no parameter-space curve, as castle.iges writes them) are
+ * projected into the surface's (u,v) domain by closest-point inversion along each curve
+ * (geometry/trim_projection.c), so those faces are trimmed as the file means; an outer loop
+ * that turns out to be the domain's own border leaves the part untrimmed (nothing to trim).
  */
 #include <ctype.h>
 #include <errno.h>
@@ -40,6 +46,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/analytic_surfaces.h"
+#include "geometry/trim_projection.h"
 #include "sem/model.h"
 #include "sem/nurbs.h"
 #include "sem/trim.h"
@@ -79,6 +87,11 @@ typedef struct iges_entry {
     unsigned char busy;        /* recursion guard */
 } iges_entry;
 
+typedef struct curve_list {
+    int n, cap;
+    sem_curve *c;
+} curve_list;
+
 typedef struct iges_reader {
     const char *name;
     sem_model *model;
@@ -93,12 +106,20 @@ typedef struct iges_reader {
     size_t n_tokens, cap_tokens;
     iges_entry *entries;
     int n_entries;
+    /* Surfaces whose extent or parameters the file does not give (an unbounded plane, 108
+     * without a display size; the analytic surfaces 190-198, unbounded or parameterized
+     * differently from our NURBS): when a trimmed entity or face that uses one has
+     * model-space boundary curves, it sets surface_hint; the surface comes out as a NURBS
+     * with from_hint = 1 and hint_fit saying how to size it to those curves (HINT_*), and
+     * its loops come from projecting them. */
+    int surface_hint;
+    int from_hint;
+    int hint_fit;
+    int hint_seam; /* the surface's seam may be turned to suit the boundary */
 } iges_reader;
 
-typedef struct curve_list {
-    int n, cap;
-    sem_curve *c;
-} curve_list;
+enum { HINT_NONE, HINT_PLANE, HINT_AXIAL };
+
 
 /* ---------------------------------------------------------------- errors ---- */
 
@@ -886,6 +907,17 @@ static void curve_reverse(sem_curve *c)
 
 /* Inserts knot t (strictly inside the knot range) `times` times, clamped so that its
  * multiplicity stays <= degree (Piegl & Tiller A5.1, in homogeneous coordinates). */
+/* Reverses the run of curves l->c[first..] as a piece of a chain: order and direction. */
+static void reverse_curves(curve_list *l, int first)
+{
+    for (int a = first, b = l->n - 1; a < b; ++a, --b) {
+        sem_curve t = l->c[a];
+        l->c[a] = l->c[b];
+        l->c[b] = t;
+    }
+    for (int a = first; a < l->n; ++a) curve_reverse(&l->c[a]);
+}
+
 static sem_status curve_insert_knot(sem_curve *c, double t, int times)
 {
     int p = c->degree, n = c->n_ctrl;
@@ -1371,6 +1403,12 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     double o[3] = {xyz[0] - off * n[0], xyz[1] - off * n[1], xyz[2] - off * n[2]};
     if (sem_surface_alloc(&part->surface, 1, 1, 2, 2) != SEM_OK) return nomem(r);
     if (ptr < 0) {
+        if (!(size > 0) && r->surface_hint) {
+            set_bilinear(&part->surface, o, e1, e2, -1.0, 1.0, -1.0, 1.0);
+            r->from_hint = 1;
+            r->hint_fit = HINT_PLANE;
+            return SEM_OK;
+        }
         if (!(size > 0)) {
             sem_surface_free(&part->surface);
             sem_model_warn(r->model, "entity 108 (DE %d): unbounded plane without a display "
@@ -1586,6 +1624,85 @@ static sem_status read_tabulated(iges_reader *r, int idx, int depth, sem_surface
     return SEM_OK;
 }
 
+/* A point (116) or direction (123) entity's three coordinates. */
+static sem_status read_vector(iges_reader *r, int owner, int k, int want, int allow_null,
+                              double out[3], int *present)
+{
+    int p = -1;
+    *present = 0;
+    sem_status st = param_ptr(r, owner, k, allow_null, &p);
+    if (st != SEM_OK || p < 0) return st;
+    if (r->entries[p].type != want)
+        return entity_error(r, owner, token_line(r, owner, k),
+                            "parameter %d points to DE %d, a type-%d entity, where a %s (%d) is "
+                            "expected",
+                            k, de_number(p), r->entries[p].type,
+                            want == 116 ? "point" : "direction", want);
+    st = need(r, p, 1, 3, want == 116 ? "point" : "direction");
+    for (int d = 0; st == SEM_OK && d < 3; ++d) st = param_real(r, p, 1 + d, &out[d]);
+    if (st == SEM_OK) {
+        r->entries[p].n_used = 4;
+        *present = 1;
+    }
+    return st;
+}
+
+/* 190-198 (IGES 5.3 analytic surfaces) as exact NURBS (geometry/analytic_surfaces.c):
+ * plane, right circular cylinder and cone, sphere, torus. Their parameters are ours, not the
+ * file's, so their loops come from model space (from_hint); planes, cylinders and cones are
+ * unbounded and need the boundary to size them (surface_hint), spheres and tori are whole. */
+static sem_status read_analytic(iges_reader *r, int idx, sem_part *part)
+{
+    const iges_entry *e = &r->entries[idx];
+    int type = e->type, form = e->form, have, have_axis = 0, have_ref = 0;
+    double loc[3], axis[3] = {0, 0, 1}, ref[3], radius = 0, second = 0;
+    sem_status st = read_vector(r, idx, 1, 116, 0, loc, &have);
+    int k = 2;
+    if (st == SEM_OK && type != 196) {
+        st = read_vector(r, idx, 2, 123, 0, axis, &have_axis);
+        k = 3;
+    }
+    if (st == SEM_OK && type != 190) st = param_real(r, idx, k++, &radius);
+    if (st == SEM_OK && (type == 194 || type == 198)) st = param_real(r, idx, k++, &second);
+    if (st == SEM_OK && type == 196 && form == 1) st = read_vector(r, idx, k++, 123, 1, axis, &have_axis);
+    if (st == SEM_OK && form == 1) st = read_vector(r, idx, k++, 123, 1, ref, &have_ref);
+    if (st != SEM_OK) return st;
+    r->entries[idx].n_used = k;
+    if (type != 190 && !(radius > 0))
+        return entity_error(r, idx, 0, "radius must be positive (got %g)", radius);
+    if (type == 198 && !(second > 0 && second < radius))
+        return entity_error(r, idx, 0, "minor radius must be in (0, major radius) (got %g)", second);
+    if (type == 194 && !(fabs(second) < 90))
+        return entity_error(r, idx, 0, "cone semi-angle must be below 90 degrees (got %g)", second);
+    int bounded = type == 196 || type == 198;
+    if (!bounded && !r->surface_hint) {
+        const char *d = entity_description(type);
+        sem_model_warn(r->model, "entity %d (DE %d): unbounded %s outside a trimmed face, skipped",
+                       type, de_number(idx), d ? d : "surface");
+        return SEM_ERR_UNSUPPORTED;
+    }
+    sem_frame f;
+    sem_error ferr;
+    if (sem_frame_make(loc, axis, have_ref ? ref : NULL, &f, &ferr) != SEM_OK)
+        return entity_error(r, idx, 0, "axis or normal direction is zero");
+    switch (type) {
+    case 190: st = sem_analytic_plane(&part->surface, &f, 1.0, &ferr); break;
+    case 192: st = sem_analytic_cone(&part->surface, &f, radius, 0.0, 0.0, 1.0, &ferr); break;
+    case 194:
+        st = sem_analytic_cone(&part->surface, &f, radius, tan(second * M_PI / 180.0), 0.0, 1.0,
+                               &ferr);
+        break;
+    case 196: st = sem_analytic_sphere(&part->surface, &f, radius, &ferr); break;
+    default: st = sem_analytic_torus(&part->surface, &f, radius, second, &ferr); break;
+    }
+    if (st != SEM_OK) return nomem(r);
+    r->from_hint = 1;
+    r->hint_fit = type == 190 ? HINT_PLANE : (type == 192 || type == 194) ? HINT_AXIAL : HINT_NONE;
+    /* form 0 does not say where the seam is: place it by the face's boundary */
+    r->hint_seam = type != 190 && !have_ref;
+    return SEM_OK;
+}
+
 /* Any surface entity as a NURBS surface in the coordinates parent o (own transform). A
  * bounded plane also fills part->outer. */
 static sem_status read_surface(iges_reader *r, int idx, const double *parent, int depth,
@@ -1605,6 +1722,11 @@ static sem_status read_surface(iges_reader *r, int idx, const double *parent, in
     case 118: st = read_ruled(r, idx, depth, &part->surface); break;
     case 120: st = read_revolution(r, idx, depth, &part->surface); break;
     case 122: st = read_tabulated(r, idx, depth, &part->surface); break;
+    case 190:
+    case 192:
+    case 194:
+    case 196:
+    case 198: st = read_analytic(r, idx, part); break;
     default:
         st = is_surface_type(e->type) ? unsupported(r, idx, "not supported, skipped")
                                       : entity_error(r, idx, 0, "a surface was expected here");
@@ -1732,30 +1854,164 @@ static void set_outer(sem_part *part, curve_list *l)
     memset(l, 0, sizeof *l);
 }
 
-/* Parameter-space curve of a 142 into l; SEM_ERR_UNSUPPORTED (with a warning) when the
- * entity has none or it cannot be converted. */
-static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, curve_list *l)
+/* A loop known only in model space (curves in loop order, in the surface's coordinates)
+ * projected into the part's (u,v) domain. SEM_ERR_UNSUPPORTED (with a warning naming the
+ * entity and why) when it cannot be. */
+static sem_status project_model_space_loop(iges_reader *r, int idx, const sem_part *part,
+                                           curve_list *model_space, curve_list *l, int *border)
 {
-    int p;
-    sem_status st = param_ptr(r, owner, k, 0, &p);
+    *border = 0;
+    if (model_space->n == 0) {
+        sem_model_warn(r->model, "entity %d (DE %d): boundary has neither parameter-space nor "
+                                 "model-space curves; that loop is left out",
+                       r->entries[idx].type, de_number(idx));
+        return SEM_ERR_UNSUPPORTED;
+    }
+    sem_surface_sampler sampler;
+    sem_error perr;
+    sem_status st = sem_surface_sampler_build(&part->surface, &sampler, &perr);
+    if (st == SEM_ERR_NOMEM) return nomem(r);
+    sem_trim_projection_settings settings = sem_default_trim_projection_settings(&part->surface);
+    sem_trim_loop loop;
+    if (st == SEM_OK)
+        st = sem_trim_project_loop(&sampler, model_space->c, model_space->n, &settings, &loop,
+                                   border, &perr);
+    sem_surface_sampler_free(&sampler);
+    if (st == SEM_ERR_NOMEM) return nomem(r);
+    if (st != SEM_OK) {
+        sem_model_warn(r->model, "entity %d (DE %d): boundary given in model space only could "
+                                 "not be projected onto its surface (%s); that loop is left out",
+                       r->entries[idx].type, de_number(idx), perr.message);
+        return SEM_ERR_UNSUPPORTED;
+    }
+    list_free(l);
+    l->n = l->cap = loop.n_curves;
+    l->c = loop.curves;
+    return SEM_OK;
+}
+
+/* The 142 at parameter k of owner, checked. */
+static sem_status curve_on_surface_entity(iges_reader *r, int owner, int k, int *p)
+{
+    sem_status st = param_ptr(r, owner, k, 0, p);
     if (st != SEM_OK) return st;
-    if (r->entries[p].type != 142)
+    if (r->entries[*p].type != 142)
         return entity_error(r, owner, token_line(r, owner, k),
                             "parameter %d points to DE %d, a type-%d entity, where a curve on a "
                             "surface (142) is expected",
-                            k, de_number(p), r->entries[p].type);
-    int bptr;
-    st = need(r, p, 1, 5, "curve on a parametric surface");
+                            k, de_number(*p), r->entries[*p].type);
+    st = need(r, *p, 1, 5, "curve on a parametric surface");
+    if (st == SEM_OK) r->entries[*p].n_used = 6;
+    return st;
+}
+
+/* The loop of a 142 (parameter k of owner) into l: its parameter-space curve (BPTR); or,
+ * when it has none or model_space is set (the surface is an unbounded plane fitted to the
+ * boundary, whose (u,v) the file's curves do not know), its model-space curve (CPTR, in the
+ * coordinates m) projected onto the part's surface. SEM_ERR_UNSUPPORTED (with a warning)
+ * when neither works. *border: the loop is the surface's own border. */
+static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, const double *m,
+                                   const sem_part *part, int model_space, curve_list *l,
+                                   int *border)
+{
+    *border = 0;
+    int p, bptr, cptr;
+    sem_status st = curve_on_surface_entity(r, owner, k, &p);
     if (st == SEM_OK) st = param_ptr(r, p, 3, 1, &bptr);
+    if (st == SEM_OK) st = param_ptr(r, p, 4, 1, &cptr);
     if (st != SEM_OK) return st;
-    r->entries[p].n_used = 6;
-    if (bptr < 0) {
-        sem_model_warn(r->model, "entity 142 (DE %d): no parameter-space curve (BPTR = 0); the "
-                                 "loop is left out",
+    if (bptr >= 0 && !model_space) return read_curves(r, bptr, identity_xf, depth + 1, l);
+    if (cptr < 0) {
+        sem_model_warn(r->model, "entity 142 (DE %d): no parameter-space curve (BPTR = 0) and no "
+                                 "model-space curve (CPTR = 0); the loop is left out",
                        de_number(p));
         return SEM_ERR_UNSUPPORTED;
     }
-    return read_curves(r, bptr, identity_xf, depth + 1, l);
+    curve_list c;
+    memset(&c, 0, sizeof c);
+    st = read_curves(r, cptr, m, depth + 1, &c);
+    if (st == SEM_OK) st = project_model_space_loop(r, p, part, &c, l, border);
+    list_free(&c);
+    return st;
+}
+
+/* The model-space curves (CPTR) of every 142 of a 144, for fitting an unbounded plane.
+ * Best effort: a curve that cannot be read is left out of the hint (its loop reports it). */
+static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *m, int depth,
+                         curve_list *hint)
+{
+    for (int i = n1 != 0 ? 0 : 1; i <= n2; ++i) {
+        int p, cptr;
+        if (curve_on_surface_entity(r, idx, 4 + i, &p) != SEM_OK) continue;
+        if (param_ptr(r, p, 4, 1, &cptr) != SEM_OK || cptr < 0) continue;
+        curve_list c;
+        memset(&c, 0, sizeof c);
+        if (read_curves(r, cptr, m, depth + 1, &c) == SEM_OK)
+            for (int j = 0; j < c.n; ++j)
+                if (list_push(r, hint, &c.c[j]) != SEM_OK) sem_curve_free(&c.c[j]);
+        free(c.c);
+    }
+}
+
+/* Reads the surface of a trimmed entity; an unbounded plane is fitted to the hint curves.
+ * *from_hint: it was (its loops must then come from model space). */
+static sem_status read_trimmed_surface(iges_reader *r, int surf, const double *m, int depth,
+                                       const curve_list *hint, sem_part *part, int *from_hint)
+{
+    r->surface_hint = hint->n > 0;
+    r->from_hint = 0;
+    r->hint_fit = HINT_NONE;
+    r->hint_seam = 0;
+    sem_status st = read_surface(r, surf, m, depth + 1, part);
+    r->surface_hint = 0;
+    *from_hint = st == SEM_OK && r->from_hint;
+    if (*from_hint && (r->hint_fit != HINT_NONE || r->hint_seam) && hint->n > 0) {
+        size_t n = 0;
+        for (int i = 0; i < hint->n; ++i) n += (size_t)hint->c[i].n_ctrl;
+        double *points = malloc((n ? n : 1) * 3 * sizeof *points);
+        if (!points) {
+            sem_part_free(part);
+            return nomem(r);
+        }
+        size_t k = 0;
+        for (int i = 0; i < hint->n; ++i) {
+            memcpy(points + 3 * k, hint->c[i].ctrl, (size_t)hint->c[i].n_ctrl * 3 * sizeof *points);
+            k += (size_t)hint->c[i].n_ctrl;
+        }
+        if (r->hint_seam) {
+            /* the seam needs points on the curves (control points of arcs leave gaps) */
+            size_t ns = 0;
+            for (int i = 0; i < hint->n; ++i) ns += 16 * (size_t)(hint->c[i].n_ctrl + 1) + 1;
+            double *samples = malloc(ns * 3 * sizeof *samples);
+            size_t *offsets = malloc(((size_t)hint->n + 1) * sizeof *offsets);
+            if (samples && offsets) {
+                size_t k = 0;
+                for (int i = 0; i < hint->n; ++i) {
+                    const sem_curve *c = &hint->c[i];
+                    int steps = 16 * (c->n_ctrl + 1);
+                    offsets[i] = k;
+                    for (int j = 0; j <= steps; ++j)
+                        sem_curve_eval(c, c->t0 + (c->t1 - c->t0) * j / steps, samples + 3 * k++,
+                                       NULL);
+                }
+                offsets[hint->n] = k;
+                sem_surface_place_seam(&part->surface, samples, offsets, hint->n);
+            }
+            free(samples);
+            free(offsets);
+        }
+        if (r->hint_fit == HINT_PLANE) sem_surface_fit_plane_rectangle(&part->surface, points, n);
+        else if (r->hint_fit == HINT_AXIAL) sem_surface_fit_axial_range(&part->surface, points, n);
+        free(points);
+    }
+    return st;
+}
+
+/* Surfaces that need their boundary to be read (see iges_reader.surface_hint). */
+static int needs_hint(const iges_reader *r, int surf)
+{
+    int t = r->entries[surf].type;
+    return t == 108 || (t >= 190 && t <= 198 && t % 2 == 0);
 }
 
 static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, int depth)
@@ -1769,21 +2025,27 @@ static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, in
     r->entries[idx].n_used = 5 + n2;
     double m[12];
     st = own_xform(r, idx, parent, m);
+    curve_list hint;
+    memset(&hint, 0, sizeof hint);
+    if (st == SEM_OK && needs_hint(r, surf)) trimmed_hint(r, idx, n1, n2, m, depth, &hint);
     sem_part part;
     memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
+    int model_space = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &model_space);
+    list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
     curve_list l;
     memset(&l, 0, sizeof l);
+    int border = 0;
     if (n1 != 0) {
-        st = curve_on_surface(r, idx, 4, depth, &l);
-        if (st == SEM_OK) set_outer(&part, &l);
+        st = curve_on_surface(r, idx, 4, depth, m, &part, model_space, &l, &border);
+        if (st == SEM_OK && !border) set_outer(&part, &l);
     }
     for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n2; ++i) {
         list_free(&l);
-        st = curve_on_surface(r, idx, 5 + i, depth, &l);
-        if (st == SEM_OK) st = add_hole(r, &part, &l);
+        st = curve_on_surface(r, idx, 5 + i, depth, m, &part, model_space, &l, &border);
+        if (st == SEM_OK && !border) st = add_hole(r, &part, &l);
     }
     list_free(&l);
     if (st != SEM_OK && st != SEM_ERR_UNSUPPORTED) {
@@ -1793,9 +2055,13 @@ static sem_status emit_trimmed(iges_reader *r, int idx, const double *parent, in
     return finish_part(r, &part, idx, surf);
 }
 
-/* One 141 boundary: its parameter-space curves, reversed where SENSE = 2. */
-static sem_status boundary_loop(iges_reader *r, int idx, int depth, curve_list *l)
+/* One 141 boundary: its parameter-space curves, reversed where SENSE = 2; when some curve
+ * has none, the model-space curves (in the coordinates m of the surface) projected onto the
+ * part's surface instead. */
+static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int depth,
+                                const sem_part *part, int model_space, curve_list *l, int *border)
 {
+    *border = 0;
     if (r->entries[idx].type != 141)
         return entity_error(r, idx, 0, "a boundary entity (141) was expected here");
     int type, n;
@@ -1817,26 +2083,37 @@ static sem_status boundary_loop(iges_reader *r, int idx, int depth, curve_list *
             st = param_ptr(r, idx, k + 3 + j, 0, &p);
             if (st == SEM_OK) st = read_curves(r, p, identity_xf, depth + 1, l);
         }
-        if (st == SEM_OK && sense == 2) {
-            for (int a = first, b = l->n - 1; a < b; ++a, --b) {
-                sem_curve t = l->c[a];
-                l->c[a] = l->c[b];
-                l->c[b] = t;
-            }
-            for (int a = first; a < l->n; ++a) curve_reverse(&l->c[a]);
-        }
+        if (st == SEM_OK && sense == 2) reverse_curves(l, first);
         k += 3 + kk;
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    if (missing || n == 0) {
-        sem_model_warn(r->model, "entity 141 (DE %d): boundary given without parameter-space "
-                                 "curves (type %d); that loop is left out (an outer loop: the "
-                                 "part keeps its whole domain)",
-                       de_number(idx), type);
-        return SEM_ERR_UNSUPPORTED;
+    if (!missing && n > 0 && !model_space) return SEM_OK;
+    list_free(l);
+
+    /* the model-space curves (parameter 5, 5 + 3 + K1, ...) in loop order */
+    curve_list model_curves;
+    memset(&model_curves, 0, sizeof model_curves);
+    k = 5;
+    for (int i = 0; st == SEM_OK && i < n; ++i) {
+        int crv, sense, kk, first = model_curves.n;
+        st = param_ptr(r, idx, k, 0, &crv);
+        if (st == SEM_OK) st = param_int(r, idx, k + 1, &sense);
+        if (st == SEM_OK) st = param_int(r, idx, k + 2, &kk);
+        if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, &model_curves);
+        if (st == SEM_OK && sense == 2) reverse_curves(&model_curves, first);
+        k += 3 + kk;
     }
-    return SEM_OK;
+    if (st == SEM_OK && !part) {
+        /* only the curves are wanted (a hint for the surface) */
+        for (int i = 0; i < model_curves.n; ++i)
+            if (list_push(r, l, &model_curves.c[i]) != SEM_OK) sem_curve_free(&model_curves.c[i]);
+        free(model_curves.c);
+        return SEM_OK;
+    }
+    if (st == SEM_OK) st = project_model_space_loop(r, idx, part, &model_curves, l, border);
+    list_free(&model_curves);
+    return st;
 }
 
 static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, int depth)
@@ -1849,19 +2126,29 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     r->entries[idx].n_used = 4 + n;
     double m[12];
     st = own_xform(r, idx, parent, m);
+    /* a surface that needs its boundary to be sized: every boundary's model-space curves */
+    curve_list hint;
+    memset(&hint, 0, sizeof hint);
+    for (int i = 0; st == SEM_OK && needs_hint(r, surf) && i < n; ++i) {
+        int b, border;
+        if (param_ptr(r, idx, 4 + i, 0, &b) == SEM_OK)
+            (void)boundary_loop(r, b, m, depth + 1, NULL, 1, &hint, &border);
+    }
     sem_part part;
     memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
+    int model_space = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &model_space);
+    list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
     curve_list l;
     memset(&l, 0, sizeof l);
     for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n; ++i) {
-        int b;
+        int b, border = 0;
         list_free(&l);
         st = param_ptr(r, idx, 4 + i, 0, &b);
-        if (st == SEM_OK) st = boundary_loop(r, b, depth + 1, &l);
-        if (st != SEM_OK) continue;
+        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, model_space, &l, &border);
+        if (st != SEM_OK || border) continue; /* border: the surface's own, nothing to trim */
         if (i == 0)
             set_outer(&part, &l);
         else
@@ -1875,16 +2162,37 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     return finish_part(r, &part, idx, surf);
 }
 
-/* A 508 loop: the parameter-space curves of its edges in order. SEM_ERR_UNSUPPORTED when an
- * edge has none. */
-static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
+/* Model-space curve of edge `index` (1-based) of a 504 edge list, in the coordinates m. */
+static sem_status edge_curve(iges_reader *r, int owner, int k, int list, int index,
+                             const double *m, int depth, curve_list *l)
+{
+    int n, crv;
+    sem_status st = param_int(r, list, 1, &n);
+    if (st == SEM_OK) st = need(r, list, 2, 5LL * n, "edge list (N edges)");
+    if (st != SEM_OK) return st;
+    if (index < 1 || index > n)
+        return entity_error(r, owner, token_line(r, owner, k),
+                            "edge index %d is outside edge list DE %d (%d edges)", index,
+                            de_number(list), n);
+    r->entries[list].n_used = 2 + 5 * n;
+    st = param_ptr(r, list, 2 + 5 * (index - 1), 0, &crv);
+    if (st == SEM_OK) st = read_curves(r, crv, m, depth + 1, l);
+    return st;
+}
+
+/* A 508 loop: the parameter-space curves of its edges in order into l, and (for faces
+ * whose edges lack them) the edges' model-space curves, in the coordinates m, into
+ * model_space. *missing: some edge had no parameter-space curve. */
+static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth, curve_list *l,
+                            curve_list *model_space, int force_model_space, int *missing)
 {
     if (r->entries[idx].type != 508)
         return entity_error(r, idx, 0, "a loop entity (508) was expected here");
     int n;
     sem_status st = param_int(r, idx, 1, &n);
     if (st == SEM_OK) st = need(r, idx, 2, 5LL * n, "loop (N edges)");
-    int k = 2, missing = 0;
+    int k = 2;
+    *missing = 0;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
         int type, edge, kk;
         st = need(r, idx, k, 5, "loop edge");
@@ -1900,9 +2208,9 @@ static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
                               i + 1, de_number(edge), r->entries[edge].type, want);
             break;
         }
-        if (type != 1 && kk == 0) missing = 1;
+        if (type != 1 && kk == 0) *missing = 1;
         for (int j = 0; st == SEM_OK && j < kk; ++j) {
-            int p;
+            int p = -1;
             st = param_ptr(r, idx, k + 6 + 2 * j, 0, &p);
             if (st == SEM_OK) st = read_curves(r, p, identity_xf, depth + 1, l);
         }
@@ -1910,7 +2218,26 @@ static sem_status face_loop(iges_reader *r, int idx, int depth, curve_list *l)
     }
     if (st != SEM_OK) return st;
     r->entries[idx].n_used = k;
-    return missing ? SEM_ERR_UNSUPPORTED : SEM_OK;
+    if (!*missing && !force_model_space) return SEM_OK;
+    /* the edges' model-space curves, in loop order (a vertex "edge", type 1, adds none: it
+     * is a collapsed edge) */
+    k = 2;
+    for (int i = 0; st == SEM_OK && i < n; ++i) {
+        int type, edge, index, forward, kk;
+        st = param_int(r, idx, k, &type);
+        if (st == SEM_OK) st = param_ptr(r, idx, k + 1, 0, &edge);
+        if (st == SEM_OK) st = param_int(r, idx, k + 2, &index);
+        if (st == SEM_OK) st = param_int(r, idx, k + 3, &forward);
+        if (st == SEM_OK) st = param_int(r, idx, k + 4, &kk);
+        int first = model_space->n;
+        if (st == SEM_OK && type != 1)
+            st = edge_curve(r, idx, k + 2, edge, index, m, depth, model_space);
+        /* OF = 0: the loop runs the edge backwards (this matters for closed edges, whose
+         * direction cannot be told from their ends) */
+        if (st == SEM_OK && !forward) reverse_curves(model_space, first);
+        k += 5 + 2 * kk;
+    }
+    return st;
 }
 
 static sem_status emit_face(iges_reader *r, int idx, const double *parent, int depth)
@@ -1926,39 +2253,59 @@ static sem_status emit_face(iges_reader *r, int idx, const double *parent, int d
     r->entries[idx].n_used = 4 + n;
     double m[12];
     st = own_xform(r, idx, parent, m);
+    curve_list l, model_space, hint;
+    memset(&l, 0, sizeof l);
+    memset(&model_space, 0, sizeof model_space);
+    memset(&hint, 0, sizeof hint);
+    /* a surface that needs its boundary to be sized: every loop's edges */
+    for (int i = 0; st == SEM_OK && needs_hint(r, surf) && i < n; ++i) {
+        int p, missing;
+        list_free(&l);
+        if (param_ptr(r, idx, 4 + i, 0, &p) == SEM_OK)
+            (void)face_loop(r, p, m, depth + 1, &l, &hint, 1, &missing);
+    }
+    list_free(&l);
     sem_part part;
     memset(&part, 0, sizeof part);
-    if (st == SEM_OK) st = read_surface(r, surf, m, depth + 1, &part);
+    int from_hint = 0;
+    if (st == SEM_OK) st = read_trimmed_surface(r, surf, m, depth, &hint, &part, &from_hint);
+    list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
-    curve_list l;
-    memset(&l, 0, sizeof l);
-    int missing = 0;
+    int failed = 0;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int p;
+        int p, missing = 0, border = 0;
         list_free(&l);
+        list_free(&model_space);
         st = param_ptr(r, idx, 4 + i, 0, &p);
-        if (st == SEM_OK) st = face_loop(r, p, depth + 1, &l);
+        if (st == SEM_OK) st = face_loop(r, p, m, depth + 1, &l, &model_space, from_hint, &missing);
+        if (st == SEM_OK && (missing || from_hint)) {
+            /* no (u,v) curves for this loop: project its edges' model-space curves */
+            st = project_model_space_loop(r, p, &part, &model_space, &l, &border);
+        }
         if (st == SEM_ERR_UNSUPPORTED) {
-            missing = 1;
+            failed = 1;
             st = SEM_OK;
             continue;
         }
         if (st != SEM_OK) break;
+        if (border) continue; /* the surface's own border: nothing to trim */
         if (i == 0 && of == 1)
             set_outer(&part, &l);
         else
             st = add_hole(r, &part, &l);
     }
     list_free(&l);
+    list_free(&model_space);
     if (st != SEM_OK) {
         sem_part_free(&part);
         return st;
     }
-    if (missing) {
-        /* without every loop's (u,v) curves the face cannot be trimmed consistently */
-        sem_model_warn(r->model, "entity 510 (DE %d): face has no parameter-space trim curves; "
-                                 "kept untrimmed",
+    if (failed) {
+        /* without every loop the face cannot be trimmed consistently (the failing loop
+         * said why) */
+        sem_model_warn(r->model, "entity 510 (DE %d): a loop of the face could not be built; "
+                                 "the face is kept untrimmed",
                        de_number(idx));
         sem_part keep;
         memset(&keep, 0, sizeof keep);
@@ -2060,7 +2407,12 @@ static sem_status emit_entity(iges_reader *r, int idx, const double *parent, int
     case 118:
     case 120:
     case 122:
-    case 128: {
+    case 128:
+    case 190:
+    case 192:
+    case 194:
+    case 196:
+    case 198: {
         sem_part part;
         memset(&part, 0, sizeof part);
         sem_status st = read_surface(r, idx, parent, depth, &part);

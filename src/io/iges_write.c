@@ -26,6 +26,7 @@
  * between lines only at delimiters, never inside a number or string.
  */
 #include "sem/model.h"
+#include "sem/version.h"
 
 #include <ctype.h>
 #include <math.h>

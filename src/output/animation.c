@@ -8,14 +8,19 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "gltf.h"
 #include "io/atomic_file.h"
+#include "preprocess_view.h"
+#include "sem/preprocess.h"
 #include "sem/tessellate.h"
+#include "sem/version.h"
 
 struct sem_animation {
     sem_animation_def def;
     char dir[4096];
     char usd_path[4200];
     char frame_units[16];
+    char glb_path[4200];
     int n_objects;
     sem_model *combined;          /* all objects' parts, for the per-frame NURBS files */
     size_t *object_ctrl;          /* control points per object */
@@ -24,6 +29,7 @@ struct sem_animation {
     int n_frames, cap_frames;
     int *frame_index;
     float **frame_points;         /* per frame: all objects' mesh points concatenated */
+    float **frame_normals;        /* the same for normals (glTF only) */
     size_t points_per_frame;      /* floats */
 };
 
@@ -55,6 +61,7 @@ sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
     if (a->def.mesh_resolution < 1) a->def.mesh_resolution = 6;
     if (!(a->def.frames_per_second > 0)) a->def.frames_per_second = 24;
     snprintf(a->usd_path, sizeof a->usd_path, "%s/animation.usda", a->dir);
+    snprintf(a->glb_path, sizeof a->glb_path, "%s/animation.glb", a->dir);
     a->n_objects = n_objects;
     sem_status st = make_dirs(a->dir, err);
     if (st != SEM_OK) goto fail;
@@ -80,7 +87,7 @@ sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
         a->object_ctrl[o] = sem_model_control_points(models[o]);
         for (int i = 0; i < models[o]->n_parts; ++i)
             if ((st = sem_model_add_part(a->combined, &models[o]->parts[i], err)) != SEM_OK) goto fail;
-        if (a->def.write_mesh || a->def.write_usd) {
+        if (a->def.write_mesh || a->def.write_usd || a->def.write_glb) {
             if ((st = sem_mesh_template_build(models[o], a->def.mesh_resolution, &a->templates[o], err)) != SEM_OK)
                 goto fail;
             if ((st = sem_mesh_template_mesh(a->templates[o], &a->meshes[o], err)) != SEM_OK) goto fail;
@@ -105,8 +112,12 @@ void sem_animation_destroy(sem_animation *a)
     free(a->templates);
     free(a->meshes);
     free(a->object_ctrl);
-    for (int f = 0; f < a->n_frames; ++f) free(a->frame_points[f]);
+    for (int f = 0; f < a->n_frames; ++f) {
+        free(a->frame_points[f]);
+        if (a->frame_normals) free(a->frame_normals[f]);
+    }
     free(a->frame_points);
+    free(a->frame_normals);
     free(a->frame_index);
     free(a);
 }
@@ -114,6 +125,21 @@ void sem_animation_destroy(sem_animation *a)
 const char *sem_animation_usd_path(const sem_animation *a)
 {
     return a->usd_path;
+}
+
+const char *sem_animation_glb_path(const sem_animation *a)
+{
+    return a->glb_path;
+}
+
+sem_status sem_animation_write_preprocess(const sem_animation *a, int object, const sem_discretization *d,
+                                          sem_error *err)
+{
+    if (!a || !d || object < 0 || object >= a->n_objects)
+        return sem_error_set(err, SEM_ERR_INVALID, "sem_animation_write_preprocess: bad object %d", object);
+    char path[4400];
+    snprintf(path, sizeof path, "%s/preprocess_%d.semdisc", a->dir, object);
+    return output_write_preprocess(path, d, err);
 }
 
 sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *const *q, sem_error *err)
@@ -141,12 +167,19 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
         snprintf(path, sizeof path, "%s/frame_%04d_nurbs.obj", a->dir, frame);
         if ((st = sem_model_save(a->combined, path, err)) != SEM_OK) return st;
     }
-    if (!a->def.write_mesh && !a->def.write_usd) return SEM_OK;
+    if (!a->def.write_mesh && !a->def.write_usd && !a->def.write_glb) return SEM_OK;
     /* meshes: one object model at a time, through the combined model's parts */
-    float *pts = NULL;
-    if (a->def.write_usd) {
+    float *pts = NULL, *nrm = NULL;
+    if (a->def.write_usd || a->def.write_glb) {
         pts = malloc((a->points_per_frame + 1) * sizeof(float));
         if (!pts) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    if (a->def.write_glb) {
+        nrm = malloc((a->points_per_frame + 1) * sizeof(float));
+        if (!nrm) {
+            free(pts);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
     }
     size_t off = 0;
     int part0 = 0;
@@ -167,6 +200,7 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
         part0 += n_parts;
         if ((st = sem_mesh_update(a->templates[o], &view, &a->meshes[o], err)) != SEM_OK) {
             free(pts);
+            free(nrm);
             return st;
         }
         if (a->def.write_mesh) {
@@ -176,35 +210,80 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
                 snprintf(path, sizeof path, "%s/frame_%04d_object%d_mesh.obj", a->dir, frame, o);
             if ((st = sem_mesh_write_obj(&a->meshes[o], &view, path, err)) != SEM_OK) {
                 free(pts);
+                free(nrm);
                 return st;
             }
         }
-        if (pts) /* the USD file is in metres */
-            for (int v = 0; v < 3 * a->meshes[o].n_vertices; ++v)
+        if (pts) /* USD and glTF are in metres */
+            for (int v = 0; v < 3 * a->meshes[o].n_vertices; ++v) {
+                if (nrm) nrm[off] = (float)a->meshes[o].normals[v];
                 pts[off++] = (float)(a->meshes[o].positions[v] * a->def.frame_unit_to_meter);
+            }
     }
     if (!pts) return SEM_OK;
     if (a->n_frames == a->cap_frames) {
         int nc = a->cap_frames ? 2 * a->cap_frames : 64;
         float **fp = realloc(a->frame_points, (size_t)nc * sizeof *fp);
-        int *fi = fp ? realloc(a->frame_index, (size_t)nc * sizeof *fi) : NULL;
         if (fp) a->frame_points = fp;
-        if (!fp || !fi) {
+        int *fi = fp ? realloc(a->frame_index, (size_t)nc * sizeof *fi) : NULL;
+        if (fi) a->frame_index = fi;
+        float **fn = fi ? realloc(a->frame_normals, (size_t)nc * sizeof *fn) : NULL;
+        if (fn) a->frame_normals = fn;
+        if (!fp || !fi || !fn) {
             free(pts);
+            free(nrm);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
-        a->frame_index = fi;
         a->cap_frames = nc;
     }
     a->frame_points[a->n_frames] = pts;
+    a->frame_normals[a->n_frames] = nrm;
     a->frame_index[a->n_frames] = frame;
     a->n_frames++;
     return SEM_OK;
 }
 
+/* animation.glb: the frames kept so far (gltf.c). */
+static sem_status write_glb(const sem_animation *a, sem_error *err)
+{
+    gltf_object *objects = calloc((size_t)a->n_objects, sizeof *objects);
+    const char **names = calloc((size_t)a->combined->n_parts + 1, sizeof *names);
+    double *times = malloc((size_t)a->n_frames * sizeof *times);
+    if (!objects || !names || !times) {
+        free(objects);
+        free(names);
+        free(times);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int i = 0; i < a->combined->n_parts; ++i) names[i] = a->combined->parts[i].name;
+    int part0 = 0;
+    for (int o = 0; o < a->n_objects; ++o) {
+        objects[o].mesh = &a->meshes[o];
+        objects[o].part_names = names + part0;
+        objects[o].first_part = part0;
+        part0 += a->meshes[o].n_parts;
+    }
+    for (int f = 0; f < a->n_frames; ++f) times[f] = a->frame_index[f] / a->def.frames_per_second;
+    char generator[64];
+    snprintf(generator, sizeof generator, "sem %s", SEM_VERSION_STRING);
+    gltf_animation g = {a->n_objects, objects, a->n_frames, times, (const float *const *)a->frame_points,
+                        (const float *const *)a->frame_normals,
+                        a->combined->unit_to_meter > 0 ? a->combined->unit_to_meter : 1.0, generator};
+    sem_status st = gltf_write(a->glb_path, &g, err);
+    free(objects);
+    free(names);
+    free(times);
+    return st;
+}
+
 sem_status sem_animation_finish(sem_animation *a, sem_error *err)
 {
-    if (!a->def.write_usd || a->n_frames == 0) return SEM_OK;
+    if (a->n_frames == 0) return SEM_OK;
+    if (a->def.write_glb) {
+        sem_status st = write_glb(a, err);
+        if (st != SEM_OK) return st;
+    }
+    if (!a->def.write_usd) return SEM_OK;
     sem_atomic_file file;
     sem_status st = sem_atomic_open(&file, a->usd_path, err);
     if (st != SEM_OK) return st;

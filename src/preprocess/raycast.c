@@ -7,8 +7,10 @@
  *   simply have no geometry. The scene uses RTC_SCENE_FLAG_ROBUST (watertight traversal:
  *   a ray through a shared edge hits at least one of the two triangles) and
  *   RTC_BUILD_QUALITY_LOW (Morton build: a scene serves one preprocessing run, where the
- *   build costs more than the few rays per triangle gain from a better tree). The device
- *   is shared by the process (see acquire_device). The all-hits query still removes a
+ *   build costs more than the few rays per triangle gain from a better tree). Each scene
+ *   owns its Embree device: no process-wide state. After the first device of a process
+ *   (which starts Embree's thread pool once, ~1 ms) a new one costs ~0.05 ms, nothing
+ *   beside building even the smallest scene. The all-hits query still removes a
  *   triangle reported twice, which higher build qualities (spatial splits) can do.
  * - Precision. Embree works in single precision. We keep the tessellation in double and
  *   recompute every hit distance in double as the ray-plane distance of the hit triangle:
@@ -71,32 +73,6 @@
 
 #include "sem/nurbs.h"
 #include "sem/tessellate.h"
-
-/* One Embree device for the process: creating a device starts Embree's thread pool, which
- * costs more than building a small scene. Devices are thread-safe and reference counted;
- * every scene holds a reference, and the process's own one is dropped at exit. */
-static RTCDevice shared_device;
-
-static void release_shared_device(void)
-{
-    if (shared_device) rtcReleaseDevice(shared_device);
-    shared_device = NULL;
-}
-
-static RTCDevice acquire_device(void)
-{
-    RTCDevice d;
-#pragma omp critical(sem_raycast_device)
-    {
-        if (!shared_device) {
-            shared_device = rtcNewDevice(NULL);
-            if (shared_device) atexit(release_shared_device);
-        }
-        d = shared_device;
-        if (d) rtcRetainDevice(d);
-    }
-    return d;
-}
 
 /* The tessellation as this file uses it: vertices (3 doubles each) and triangles (3
  * vertex indices each) with the part of each triangle. */
@@ -1516,8 +1492,8 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     if (!(s->scale > 0)) s->scale = 1.0;
     s->merge_eps = 1e-7 * s->scale;
 
-    /* Embree scene */
-    s->device = acquire_device();
+    /* Embree scene, on a device of its own */
+    s->device = rtcNewDevice(NULL);
     if (!s->device) {
         free(bsamples);
         free(n_bsamples);

@@ -248,7 +248,7 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
 {
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
-                                       "tessellation", "weight_threshold", "origins", NULL};
+                                       "tessellation", "weight_threshold", "origins", "blend", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -447,6 +447,7 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     mat_identity(obj->transform);
     obj->material = sem_default_material();
     obj->sem = sem_default_preprocess_options();
+    obj->blend = SEM_DEFAULT_BLEND;
     const cJSON *model = cJSON_GetObjectItemCaseSensitive(o, "model");
     const cJSON *prim = cJSON_GetObjectItemCaseSensitive(o, "primitive");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(o, "units");
@@ -579,6 +580,15 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     if (s) {
         snprintf(w, sizeof w, "%s.sem", where);
         if ((st = parse_sem(c, s, w, &obj->sem)) != SEM_OK) return st;
+        const cJSON *bl = cJSON_GetObjectItemCaseSensitive(s, "blend");
+        if (bl && !cJSON_IsNull(bl)) {
+            if ((st = get_number(c, s, "blend", w, &obj->blend)) != SEM_OK) return st;
+            if (!(obj->blend >= 0) || obj->blend > 1e6) {
+                char w2[300];
+                snprintf(w2, sizeof w2, "%s.blend", w);
+                return fail(c, w2, "must be in 0..1e6 or null (got %g)", obj->blend);
+            }
+        }
     }
     const cJSON *pin = cJSON_GetObjectItemCaseSensitive(o, "pin");
     if (pin) {
@@ -759,7 +769,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
     if (desc && !cJSON_IsString(desc)) return fail(c, "description", "must be a string");
     const cJSON *out = cJSON_GetObjectItemCaseSensitive(root, "output");
     if (out) {
-        static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "mesh_resolution", NULL};
+        static const char *const keys[] = {"dir", "iges", "obj", "mesh", "usd", "glb", "mesh_resolution", NULL};
         if ((st = check_keys(c, out, "output", keys)) != SEM_OK) return st;
         const cJSON *d = cJSON_GetObjectItemCaseSensitive(out, "dir");
         if (d) {
@@ -770,6 +780,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
         if ((st = get_bool(c, out, "obj", "output", &s->write_obj)) != SEM_OK) return st;
         if ((st = get_bool(c, out, "mesh", "output", &s->write_mesh)) != SEM_OK) return st;
         if ((st = get_bool(c, out, "usd", "output", &s->write_usd)) != SEM_OK) return st;
+        if ((st = get_bool(c, out, "glb", "output", &s->write_glb)) != SEM_OK) return st;
         if ((st = get_int(c, out, "mesh_resolution", "output", &s->mesh_resolution)) != SEM_OK) return st;
         if (s->mesh_resolution < 1 || s->mesh_resolution > 64) return fail(c, "output.mesh_resolution", "must be in 1..64");
     }
@@ -824,6 +835,7 @@ sem_status sem_scene_parse(const char *json, const char *name, const char *base_
     s->write_obj = 0;
     s->write_mesh = 1;
     s->write_usd = 1;
+    s->write_glb = 1;
     s->mesh_resolution = 6;
     static const char *const keys[] = {"objects", "gravity", "integrator", "frames",
                                        "steps_per_frame", "output", "threads", "description", NULL};

@@ -33,6 +33,7 @@ struct sem_scene_world {
     double *file_unit_to_meter;
     char (*file_units)[16];
     sem_world *world;
+    int *spurious;             /* per object: zero-energy modes, -1 not looked for */
     int all_cached;
     double preprocess_s;
 };
@@ -132,10 +133,55 @@ void sem_scene_world_destroy(sem_scene_world *sw)
     free(sw->materials);
     free(sw->file_unit_to_meter);
     free(sw->file_units);
+    free(sw->spurious);
     free(sw);
 }
 
 /* Builds object i and adds it to the world. */
+/* Zero-energy modes of object i: a warning naming the parts that are not held. */
+static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scene_world_options *o,
+                              sem_error *err)
+{
+    const sem_model *model = sw->models[i];
+    int *flags = calloc((size_t)model->n_parts + 1, sizeof *flags);
+    if (!flags) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_object_modes m;
+    sem_status st = sem_world_object_modes(sw->world, id, &m, flags, err);
+    if (st != SEM_OK) {
+        free(flags);
+        return prefix_error(err, st, sw->scene->path[0] ? sw->scene->path : "scene", i, ": zero-energy modes: ");
+    }
+    sw->spurious[i] = m.spurious;
+    if (m.spurious > 0) {
+        char parts[600] = "";
+        size_t len = 0;
+        int listed = 0, more = 0;
+        for (int k = 0; k < model->n_parts; ++k) {
+            if (!flags[k]) continue;
+            if (listed == 12) {
+                more++;
+                continue;
+            }
+            const char *nm = model->parts[k].name;
+            int w = nm[0] ? snprintf(parts + len, sizeof parts - len, "%s%d (%s)", listed ? ", " : "", k, nm)
+                          : snprintf(parts + len, sizeof parts - len, "%s%d", listed ? ", " : "", k);
+            if (w > 0 && (size_t)w < sizeof parts - len) len += (size_t)w;
+            listed++;
+        }
+        if (more) snprintf(parts + len, sizeof parts - len, " and %d more", more);
+        logf_(o, 1,
+              "objects[%d]: %s%d zero-energy mode%s beyond the rigid motions: part%s %s %s not held by the "
+              "discretization and may drift or fall off (raise sem.blend or refine sem.spacing)",
+              i, m.spurious == m.n_values ? "at least " : "", m.spurious, m.spurious == 1 ? "" : "s",
+              listed + more == 1 ? "" : "s", parts, listed + more == 1 ? "is" : "are");
+    } else {
+        logf_(o, 0, "objects[%d]: no zero-energy modes (lowest elastic mode %.3g E / (rho L^2))%s", i,
+              m.n_values > 0 ? m.values[0] : 0.0, m.converged ? "" : " (iteration not converged)");
+    }
+    free(flags);
+    return SEM_OK;
+}
+
 static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
                                sem_error *err)
 {
@@ -171,6 +217,7 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     od.model = model;
     od.disc = sw->discs[i];
     od.material = so->material;
+    od.blend = so->blend;
     od.part_material = sw->part_material[i];
     od.part_materials = sw->materials[i];
     od.n_part_materials = so->n_part_materials;
@@ -192,9 +239,9 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     od.n_point_loads = so->n_point_loads;
     od.region_loads = so->region_loads;
     od.n_region_loads = so->n_region_loads;
-    if (sem_world_add_object(sw->world, &od, err) < 0)
-        return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
-    return SEM_OK;
+    int id = sem_world_add_object(sw->world, &od, err);
+    if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
+    return o->skip_modes ? SEM_OK : check_modes(sw, i, id, o, err);
 }
 
 sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_options *options,
@@ -218,9 +265,11 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
     sw->materials = calloc(n, sizeof *sw->materials);
     sw->file_unit_to_meter = calloc(n, sizeof *sw->file_unit_to_meter);
     sw->file_units = calloc(n, sizeof *sw->file_units);
+    sw->spurious = malloc(n * sizeof *sw->spurious);
     sem_status st = SEM_OK;
+    for (size_t k = 0; sw->spurious && k < n; ++k) sw->spurious[k] = -1;
     if (!sw->models || !sw->discs || !sw->pins || !sw->part_material || !sw->prescribe_group ||
-        !sw->prescribes || !sw->materials || !sw->file_unit_to_meter || !sw->file_units) {
+        !sw->prescribes || !sw->materials || !sw->file_unit_to_meter || !sw->file_units || !sw->spurious) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -275,6 +324,11 @@ double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object)
 }
 
 int sem_scene_world_all_cached(const sem_scene_world *sw) { return sw ? sw->all_cached : 0; }
+
+int sem_scene_world_spurious_modes(const sem_scene_world *sw, int object)
+{
+    return sw && object >= 0 && object < sw->n ? sw->spurious[object] : -1;
+}
 
 double sem_scene_world_preprocess_seconds(const sem_scene_world *sw)
 {

@@ -262,7 +262,8 @@ def file_tabulated():
 
 def file_brep():
     # 186 -> 514 with two faces. Face 1 (510) trims a patch with a square loop whose edges
-    # have parameter-space lines; face 2's loop edges have none (K = 0): kept untrimmed.
+    # have parameter-space lines; face 2's loop edges have none (K = 0): trimmed by
+    # projecting the edges' model-space lines.
     sub = "00010000"
     E = []
 
@@ -355,6 +356,173 @@ def file_bptr0():
     save("iges_bptr0.igs", build(ents))
 
 
+CIRCLE_KNOTS = [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1]
+CIRCLE_W = [1, math.sqrt(0.5)] * 4 + [1]
+CIRCLE_XY = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1), (1, 0)]
+
+
+def circle3(f):
+    """The 9-point rational quadratic unit circle mapped by f(x, y) -> (x, y, z)."""
+    return nurbs_curve(2, CIRCLE_KNOTS, [f(x, y) for x, y in CIRCLE_XY], CIRCLE_W)
+
+
+def file_model_space():
+    """Trims given in model space only (no parameter-space curves anywhere), with closed
+    forms for the trimmed areas:
+    part 0: 143 on the plane patch [0,2]x[0,1] (z = 0); outer 141 TYPE 0 = the patch's own
+            border (4 lines), hole 141 TYPE 0 = circle of radius 0.3 around (1, 0.5):
+            area 2 - 0.09 pi, no outer trim (the border trims nothing)
+    part 1: 186 -> 514 -> 510 on a cylinder of radius 1, z 0..2, closed in u (seam at x = 1,
+            y = 0); loop = bottom circle, seam edge up, the ellipse z = 1 + x / 2 backwards,
+            the seam edge down: area 2 pi (the mean height is 1)
+    part 2: 510 on the unit sphere (u longitude with a seam, v latitude with poles): the cap
+            above z = 1/2; loop = the latitude circle, the seam meridian up to the pole and
+            down again: area 2 pi h = pi"""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    # part 0
+    t143 = add(None)
+    plane = add(Ent(128, patch(0, 0, 0, 2, 1), status=sub))
+    corners = [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)]
+    border = [add(Ent(110, line(corners[k], corners[(k + 1) % 4]), status=sub)) for k in range(4)]
+    outer = ["0", "0", de(plane), "4"]
+    for b in border:
+        outer += [de(b), "1", "0"]
+    o141 = add(Ent(141, outer, status=sub))
+    circle = add(Ent(100, ["0.0", "1.0", "0.5", "1.3", "0.5", "1.3", "0.5"], status=sub))
+    h141 = add(Ent(141, ["0", "0", de(plane), "1", de(circle), "1", "0"], status=sub))
+    E[t143] = Ent(143, ["0", de(plane), "2", de(o141), de(h141)])
+
+    # parts 1 and 2: one B-rep shell with two faces
+    i186 = add(None)
+    i514 = add(None)
+    f_cyl = add(None)
+    f_sph = add(None)
+    cyl = add(Ent(128, nurbs_surface(2, 1, CIRCLE_KNOTS, [0, 0, 1, 1],
+                                     [[(x, y, 0) for x, y in CIRCLE_XY],
+                                      [(x, y, 2) for x, y in CIRCLE_XY]],
+                                     CIRCLE_W * 2), status=sub))
+    merid = [(0, -1, 1), (1, -1, math.sqrt(0.5)), (1, 0, 1), (1, 1, math.sqrt(0.5)), (0, 1, 1)]
+    sph = add(Ent(128, nurbs_surface(2, 2, CIRCLE_KNOTS, [0, 0, 0, 0.5, 0.5, 1, 1, 1],
+                                     [[(rho * x, rho * y, z) for x, y in CIRCLE_XY]
+                                      for rho, z, _ in merid],
+                                     [wu * wv for _, _, wv in merid for wu in CIRCLE_W]),
+                  status=sub))
+    c30, s30 = math.sqrt(3) / 2, 0.5
+    verts = [(1, 0, 0), (1, 0, 1.5), (c30, 0, s30), (0, 0, 1)]
+    vl = add(Ent(502, ["4"] + [r(x) for p in verts for x in p], form=1, status=sub))
+    bottom = add(Ent(126, circle3(lambda x, y: (x, y, 0)), status=sub))
+    seam = add(Ent(110, line((1, 0, 0), (1, 0, 1.5)), status=sub))
+    ellipse = add(Ent(126, circle3(lambda x, y: (x, y, 1 + 0.5 * x)), status=sub))
+    latitude = add(Ent(126, circle3(lambda x, y: (c30 * x, c30 * y, s30)), status=sub))
+    meridian = add(Ent(126, nurbs_curve(2, [0, 0, 0, 1, 1, 1],
+                                        [(c30, 0, s30), (0.5 / c30, 0, 1), (0, 0, 1)],
+                                        [1, c30, 1]), status=sub))
+    edges = [(bottom, 1, 1), (seam, 1, 2), (ellipse, 2, 2), (latitude, 3, 3), (meridian, 3, 4)]
+    ep = [str(len(edges))]
+    for crv, a, b in edges:
+        ep += [de(crv), de(vl), str(a), de(vl), str(b)]
+    el = add(Ent(504, ep, form=1, status=sub))
+
+    def loop(entries):
+        p = [str(len(entries))]
+        for index, forward in entries:
+            p += ["0", de(el), str(index), "1" if forward else "0", "0"]
+        return add(Ent(508, p, form=1, status=sub))
+
+    l_cyl = loop([(1, True), (2, True), (3, False), (2, False)])
+    l_sph = loop([(4, True), (5, True), (5, False)])
+    E[i186] = Ent(186, [de(i514), "1", "0"])
+    E[i514] = Ent(514, ["2", de(f_cyl), "1", de(f_sph), "1"], form=1, status=sub)
+    E[f_cyl] = Ent(510, [de(cyl), "1", "1", de(l_cyl)], form=1, status=sub)
+    E[f_sph] = Ent(510, [de(sph), "1", "1", de(l_sph)], form=1, status=sub)
+    save("iges_model_space.igs", build(E))
+    # the same plate with its hole's circle 0.5 above the plane: it cannot be projected;
+    # the reader warns and leaves that loop out
+    E = E[:h141 + 1]
+    E[circle] = Ent(100, ["0.5", "1.0", "0.5", "1.3", "0.5", "1.3", "0.5"], status=sub)
+    save("iges_model_space_off.igs", build(E))
+
+
+def file_analytic():
+    """IGES 5.3 analytic surfaces (190-198) in a B-rep whose loops are in model space only
+    (as Open CASCADE's B-rep export writes them), with closed-form areas:
+    part 0: 192 form 0 cylinder (radius 1 about z), its seam edge at (0, 1): the face below
+            the ellipse z = 1 + x / 2: 2 pi (the seam is placed where the edge is)
+    part 1: 196 form 0 sphere (radius 1 around (5, 0, 0)), the cap above z = 1/2, seam
+            meridian on the -x side: pi
+    part 2: 190 form 1 plane z = 3 (refdir x): the square [-1,1]^2 with a hole of radius
+            1/2: 4 - pi / 4
+    part 3: a 198 torus (2, 0.5) on its own, whole: 4 pi^2 2 0.5
+    and a 192 cylinder on its own, unbounded: skipped with a warning."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    def point(p):
+        return add(Ent(116, [r(x) for x in p], status=sub))
+
+    def direction(d):
+        return add(Ent(123, [r(x) for x in d], form=0, status=sub))
+
+    i186 = add(None)
+    i514 = add(None)
+    faces = [add(None) for _ in range(3)]
+    cyl = add(Ent(192, [de(point((0, 0, 0))), de(direction((0, 0, 1))), "1.0"], status=sub))
+    sph = add(Ent(196, [de(point((5, 0, 0))), "1.0"], status=sub))
+    pln = add(Ent(190, [de(point((0, 0, 3))), de(direction((0, 0, 1))), de(direction((1, 0, 0)))],
+                  form=1, status=sub))
+    c30, s30 = math.sqrt(3) / 2, 0.5
+    rot = lambda x, y: (-y, x)  # circles starting at (0, 1)
+    verts = [(0, 1, 0), (0, 1, 1), (5 - c30, 0, s30), (5, 0, 1), (1, 0, 3), (-1, 0, 3),
+             (0.5, 0, 3)]
+    vl = add(Ent(502, [str(len(verts))] + [r(x) for p in verts for x in p], form=1, status=sub))
+    bottom = add(Ent(126, circle3(lambda x, y: (rot(x, y)[0], rot(x, y)[1], 0)), status=sub))
+    seam = add(Ent(110, line((0, 1, 0), (0, 1, 1)), status=sub))
+    ellipse = add(Ent(126, circle3(lambda x, y: (rot(x, y)[0], rot(x, y)[1], 1 + 0.5 * rot(x, y)[0])),
+                      status=sub))
+    latitude = add(Ent(126, circle3(lambda x, y: (5 - c30 * x, -c30 * y, s30)), status=sub))
+    meridian = add(Ent(126, nurbs_curve(2, [0, 0, 0, 1, 1, 1],
+                                        [(5 - c30, 0, s30), (5 - 0.5 / c30, 0, 1), (5, 0, 1)],
+                                        [1, c30, 1]), status=sub))
+    sq = [(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)]
+    square = [add(Ent(110, line(sq[k], sq[(k + 1) % 4]), status=sub)) for k in range(4)]
+    hole = add(Ent(100, ["3.0", "0.0", "0.0", "0.5", "0.0", "0.5", "0.0"], status=sub))
+    edges = [(bottom, 1, 1), (seam, 1, 2), (ellipse, 2, 2), (latitude, 3, 3), (meridian, 3, 4),
+             (hole, 7, 7)] + [(square[k], 1, 1) for k in range(4)]
+    ep = [str(len(edges))]
+    for crv, a, b in edges:
+        ep += [de(crv), de(vl), str(a), de(vl), str(b)]
+    el = add(Ent(504, ep, form=1, status=sub))
+
+    def loop(entries):
+        p = [str(len(entries))]
+        for index, forward in entries:
+            p += ["0", de(el), str(index), "1" if forward else "0", "0"]
+        return add(Ent(508, p, form=1, status=sub))
+
+    l_cyl = loop([(1, True), (2, True), (3, False), (2, False)])
+    l_sph = loop([(4, True), (5, True), (5, False)])
+    l_sq = loop([(7, True), (8, True), (9, True), (10, True)])
+    l_hole = loop([(6, True)])
+    E[i186] = Ent(186, [de(i514), "1", "0"])
+    E[i514] = Ent(514, ["3"] + [x for f in faces for x in (de(f), "1")], form=1, status=sub)
+    E[faces[0]] = Ent(510, [de(cyl), "1", "1", de(l_cyl)], form=1, status=sub)
+    E[faces[1]] = Ent(510, [de(sph), "1", "1", de(l_sph)], form=1, status=sub)
+    E[faces[2]] = Ent(510, [de(pln), "2", "1", de(l_sq), de(l_hole)], form=1, status=sub)
+    add(Ent(198, [de(point((0, -6, 0))), de(direction((0, 0, 1))), "2.0", "0.5"]))
+    add(Ent(192, [de(point((0, 0, 9))), de(direction((1, 0, 0))), "1.0"]))
+    save("iges_analytic.igs", build(E))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -422,4 +590,6 @@ if __name__ == "__main__":
     file_unknown()
     file_cad_trimmed()
     file_bptr0()
+    file_model_space()
+    file_analytic()
     errors()

@@ -1,0 +1,515 @@
+/*
+ * trim_projection.c - model-space trim loops into parameter space (geometry/trim_projection.h).
+ *
+ * Design. Each curve is sampled a few times per knot span, every sample is inverted onto the
+ * surface starting from the previous sample's (u,v) (geometry/closest_point.c), and each
+ * interval is halved while the surface point at the middle of the (u,v) chord departs from
+ * the projected middle of the curve by more than the tolerance: the result is a polygon in
+ * (u,v) whose image follows the curve, stored as a degree-1 B-spline (whose flattening in
+ * trim.c is this polygon again). Polygons are what trim regions are made of anyway, so
+ * nothing is lost against fitting a smooth curve, and nothing can overshoot. A curve gets at
+ * most MAX_POINTS points (trim.c flattens at most 4095 spans of a curve).
+ *
+ * Two places where (u,v) is not a function of the model-space point need care:
+ *  - seams of closed surfaces (u0 and u1 map to the same curve): a point on the seam takes
+ *    the side of its nearest neighbour off the seam within its curve; a curve that lies on
+ *    the seam (a B-rep's seam edge, traversed once on each side) takes the side on which it
+ *    joins both neighbouring curves, so it lands once on u0 and once on u1;
+ *  - collapsed edges (poles of a sphere-like patch, where x_u = 0 along v = v0): a pole
+ *    point takes u from its neighbour on the same curve, and consecutive curves that meet at
+ *    the pole with different u are joined by a straight connector along the collapsed edge
+ *    (its image is a single point, so the connector is exact).
+ */
+#include "geometry/trim_projection.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sem/nurbs.h"
+
+#define SAMPLES_PER_SPAN_MIN 4
+#define MAX_DEPTH 18
+#define MAX_POINTS 3000
+
+typedef struct point {
+    double t;
+    double uv[2];
+    double x[3]; /* S(uv) */
+} point;
+
+typedef struct chain {
+    int n, cap;
+    point *p;
+} chain;
+
+typedef struct context {
+    const sem_surface_sampler *sampler;
+    const sem_surface *s;
+    double tol, max_distance;
+    int closed[2];     /* seam: S(u0, v) == S(u1, v) (u) / the same in v */
+    double eps[2];     /* "on the border" in u and v */
+    double worst;      /* largest distance of a curve point from the surface */
+} context;
+
+static double dist3(const double *a, const double *b)
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+static double surface_size(const sem_surface *s)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t n = (size_t)s->n_u * (size_t)s->n_v;
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = fmin(lo[d], s->ctrl[3 * i + d]);
+            hi[d] = fmax(hi[d], s->ctrl[3 * i + d]);
+        }
+    double size = dist3(lo, hi);
+    return size > 0 && isfinite(size) ? size : 1.0;
+}
+
+sem_trim_projection_settings sem_default_trim_projection_settings(const sem_surface *s)
+{
+    double size = surface_size(s);
+    sem_trim_projection_settings o = {2e-5 * size, 1e-2 * size};
+    return o;
+}
+
+/* S(u0, v) == S(u1, v) along v (dir 0), or S(u, v0) == S(u, v1) along u (dir 1) */
+static int is_closed(const sem_surface *s, int dir, double tol)
+{
+    for (int k = 0; k <= 8; ++k) {
+        double a[3], b[3];
+        if (dir == 0) {
+            double v = s->v0 + (s->v1 - s->v0) * k / 8.0;
+            sem_surface_eval(s, s->u0, v, a, NULL, NULL, NULL);
+            sem_surface_eval(s, s->u1, v, b, NULL, NULL, NULL);
+        } else {
+            double u = s->u0 + (s->u1 - s->u0) * k / 8.0;
+            sem_surface_eval(s, u, s->v0, a, NULL, NULL, NULL);
+            sem_surface_eval(s, u, s->v1, b, NULL, NULL, NULL);
+        }
+        if (dist3(a, b) > tol) return 0;
+    }
+    return 1;
+}
+
+/* The line u = const (dir 0: x_u = 0 along it, a pole at this v) is collapsed when the
+ * iso-curve in u through (u,v) has (near) zero length. */
+static int collapsed_in(const context *c, int dir, const double uv[2])
+{
+    const sem_surface *s = c->s;
+    double a[3], b[3], m[3], du[3], dv[3];
+    /* cheap test first: the iso-curve cannot be collapsed where it has a tangent */
+    sem_surface_eval(s, uv[0], uv[1], m, du, dv, NULL);
+    const double *t = dir == 0 ? du : dv;
+    double span = dir == 0 ? s->u1 - s->u0 : s->v1 - s->v0;
+    if (sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) * span > c->tol) return 0;
+    if (dir == 0) {
+        sem_surface_eval(s, s->u0, uv[1], a, NULL, NULL, NULL);
+        sem_surface_eval(s, s->u1, uv[1], b, NULL, NULL, NULL);
+        sem_surface_eval(s, 0.5 * (s->u0 + s->u1), uv[1], m, NULL, NULL, NULL);
+    } else {
+        sem_surface_eval(s, uv[0], s->v0, a, NULL, NULL, NULL);
+        sem_surface_eval(s, uv[0], s->v1, b, NULL, NULL, NULL);
+        sem_surface_eval(s, uv[0], 0.5 * (s->v0 + s->v1), m, NULL, NULL, NULL);
+    }
+    return dist3(a, b) < c->tol && dist3(a, m) < c->tol;
+}
+
+static int push(chain *ch, const point *p)
+{
+    if (ch->n == ch->cap) {
+        int nc = ch->cap ? 2 * ch->cap : 64;
+        point *q = realloc(ch->p, (size_t)nc * sizeof *q);
+        if (!q) return 0;
+        ch->p = q;
+        ch->cap = nc;
+    }
+    ch->p[ch->n++] = *p;
+    return 1;
+}
+
+static void project(context *c, const sem_curve *cv, double t, const double *guess, point *out)
+{
+    double X[3];
+    sem_curve_eval(cv, t, X, NULL);
+    out->t = t;
+    double d = sem_surface_closest_point(c->sampler, X, guess, 0.1 * c->tol, out->uv);
+    if (d > c->worst) c->worst = d;
+    sem_surface_eval(c->s, out->uv[0], out->uv[1], out->x, NULL, NULL, NULL);
+}
+
+/* Points of (a, b] between a and b, refined; appended to ch. */
+static int refine(context *c, const sem_curve *cv, const point *a, const point *b, int depth,
+                  chain *ch)
+{
+    if (depth < MAX_DEPTH && ch->n < MAX_POINTS) {
+        point m;
+        double mid_uv[2] = {0.5 * (a->uv[0] + b->uv[0]), 0.5 * (a->uv[1] + b->uv[1])};
+        project(c, cv, 0.5 * (a->t + b->t), mid_uv, &m);
+        double chord[3];
+        sem_surface_eval(c->s, mid_uv[0], mid_uv[1], chord, NULL, NULL, NULL);
+        if (dist3(chord, m.x) > c->tol) {
+            if (!refine(c, cv, a, &m, depth + 1, ch)) return 0;
+            return refine(c, cv, &m, b, depth + 1, ch);
+        }
+    }
+    return push(ch, b);
+}
+
+/* One curve, from t_start to t_end, starting from guess (may be NULL). */
+static int project_curve(context *c, const sem_curve *cv, int reverse, const double *guess,
+                         chain *ch)
+{
+    double breaks[1026];
+    int nb = sem_knot_breaks(cv->degree, cv->n_ctrl, cv->knots, cv->t0, cv->t1, breaks, 1026);
+    if (nb < 2) {
+        breaks[0] = cv->t0, breaks[1] = cv->t1;
+        nb = 2;
+    }
+    int per = cv->degree + 1 > SAMPLES_PER_SPAN_MIN ? cv->degree + 1 : SAMPLES_PER_SPAN_MIN;
+    if ((nb - 1) * per > MAX_POINTS) per = MAX_POINTS / (nb - 1) > 1 ? MAX_POINTS / (nb - 1) : 1;
+    int total = (nb - 1) * per;
+    point prev;
+    for (int k = 0; k <= total; ++k) {
+        int kk = reverse ? total - k : k;
+        int span = kk / per, r = kk % per;
+        double t = span >= nb - 1 ? breaks[nb - 1]
+                                  : breaks[span] + (breaks[span + 1] - breaks[span]) * r / per;
+        point p;
+        project(c, cv, t, k == 0 ? guess : prev.uv, &p);
+        if (k == 0) {
+            if (!push(ch, &p)) return 0;
+        } else if (!refine(c, cv, &prev, &p, 0, ch)) {
+            return 0;
+        }
+        prev = p;
+    }
+    return 1;
+}
+
+static int on_seam(const context *c, int dir, double x)
+{
+    if (!c->closed[dir]) return 0;
+    const sem_surface *s = c->s;
+    double lo = dir == 0 ? s->u0 : s->v0, hi = dir == 0 ? s->u1 : s->v1;
+    return fabs(x - lo) <= c->eps[dir] || fabs(x - hi) <= c->eps[dir];
+}
+
+/* a and b can be consecutive points of a loop: equal in (u,v), or joined by a straight
+ * (u,v) segment whose image is a single point (a collapsed edge) */
+static int joinable(const context *c, const double a[2], const double b[2])
+{
+    const sem_surface *s = c->s;
+    double du = (b[0] - a[0]) / (s->u1 - s->u0), dv = (b[1] - a[1]) / (s->v1 - s->v0);
+    if (hypot(du, dv) < 1e-9) return 1;
+    double xa[3], x[3];
+    sem_surface_eval(s, a[0], a[1], xa, NULL, NULL, NULL);
+    for (int k = 1; k <= 8; ++k) {
+        sem_surface_eval(s, a[0] + (b[0] - a[0]) * k / 8.0, a[1] + (b[1] - a[1]) * k / 8.0, x,
+                         NULL, NULL, NULL);
+        if (dist3(x, xa) > c->tol) return 0;
+    }
+    return 1;
+}
+
+static int curve_on_seam(const context *c, int dir, const chain *ch)
+{
+    for (int i = 0; i < ch->n; ++i)
+        if (!on_seam(c, dir, ch->p[i].uv[dir])) return 0;
+    return 1;
+}
+
+/* Seam and pole fixes along the loop, curve by curve in chain order. */
+static void fix_seams_and_poles(context *c, chain *chains, int n)
+{
+    const sem_surface *s = c->s;
+    for (int dir = 0; dir < 2; ++dir) {
+        double lo = dir == 0 ? s->u0 : s->v0, hi = dir == 0 ? s->u1 : s->v1;
+        double mid = 0.5 * (lo + hi);
+        /* poles: a collapsed iso-line of the *other* direction leaves this parameter
+         * arbitrary; take the neighbour's */
+        for (int k = 0; k < n; ++k) {
+            chain *ch = &chains[k];
+            for (int i = 0; i < ch->n; ++i) {
+                if (!collapsed_in(c, dir, ch->p[i].uv)) continue;
+                int j = i - 1 >= 0 && !collapsed_in(c, dir, ch->p[i - 1].uv) ? i - 1
+                        : i + 1 < ch->n ? i + 1 : -1;
+                if (j >= 0 && !collapsed_in(c, dir, ch->p[j].uv)) ch->p[i].uv[dir] = ch->p[j].uv[dir];
+            }
+        }
+        if (!c->closed[dir]) continue;
+        /* a point on the seam in a curve that leaves it takes the side of the nearest
+         * point of that curve off the seam */
+        unsigned char *pure = calloc((size_t)n, 1);
+        if (!pure) return;
+        for (int k = 0; k < n; ++k) {
+            chain *ch = &chains[k];
+            pure[k] = (unsigned char)curve_on_seam(c, dir, ch);
+            if (pure[k]) continue;
+            for (int i = 0; i < ch->n; ++i) {
+                double *x = &ch->p[i].uv[dir];
+                if (!on_seam(c, dir, *x)) continue;
+                double ref = NAN;
+                for (int d = 1; d < ch->n && isnan(ref); ++d) {
+                    if (i - d >= 0 && !on_seam(c, dir, ch->p[i - d].uv[dir]))
+                        ref = ch->p[i - d].uv[dir];
+                    else if (i + d < ch->n && !on_seam(c, dir, ch->p[i + d].uv[dir]))
+                        ref = ch->p[i + d].uv[dir];
+                }
+                *x = ref < mid ? lo : hi;
+            }
+        }
+        /* a seam edge (every point on the seam; a B-rep runs it once on each side) takes
+         * the side on which it joins both of its neighbours in (u,v); the next curve counts
+         * only once it is settled */
+        for (int k = 0; k < n; ++k) {
+            if (!pure[k]) continue;
+            chain *ch = &chains[k];
+            const chain *prev = &chains[(k + n - 1) % n], *next = &chains[(k + 1) % n];
+            int best_score = -1;
+            double best = lo;
+            for (int side = 0; side < 2; ++side) {
+                double value = side ? hi : lo;
+                double a[2] = {ch->p[0].uv[0], ch->p[0].uv[1]};
+                double b[2] = {ch->p[ch->n - 1].uv[0], ch->p[ch->n - 1].uv[1]};
+                a[dir] = b[dir] = value;
+                int score = 0;
+                if (n > 1 && !pure[(k + n - 1) % n] && joinable(c, prev->p[prev->n - 1].uv, a))
+                    score += 2;
+                if (n > 1 && !pure[(k + 1) % n] && joinable(c, b, next->p[0].uv)) score += 2;
+                /* ties: continue from the previous curve's side */
+                if (n > 1 && fabs(prev->p[prev->n - 1].uv[dir] - value) <= c->eps[dir]) score += 1;
+                if (score > best_score) best_score = score, best = value;
+            }
+            for (int i = 0; i < ch->n; ++i) ch->p[i].uv[dir] = best;
+            pure[k] = 0; /* settled */
+        }
+        free(pure);
+    }
+}
+
+/* The point is on the border of the domain: its image is within tol of the image of the
+ * nearest border point (so a curve lying on an edge within the file's tolerance counts). */
+static int on_border(const context *c, const double uv[2])
+{
+    const sem_surface *s = c->s;
+    double du0 = uv[0] - s->u0, du1 = s->u1 - uv[0], dv0 = uv[1] - s->v0, dv1 = s->v1 - uv[1];
+    double ru = fmin(du0, du1) / (s->u1 - s->u0), rv = fmin(dv0, dv1) / (s->v1 - s->v0);
+    double b[2] = {uv[0], uv[1]};
+    if (ru <= rv) b[0] = du0 <= du1 ? s->u0 : s->u1;
+    else b[1] = dv0 <= dv1 ? s->v0 : s->v1;
+    double x[3], y[3];
+    sem_surface_eval(s, uv[0], uv[1], x, NULL, NULL, NULL);
+    sem_surface_eval(s, b[0], b[1], y, NULL, NULL, NULL);
+    return dist3(x, y) <= c->tol;
+}
+
+static int all_on_border(const context *c, const chain *chains, int n)
+{
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i < chains[k].n; ++i)
+            if (!on_border(c, chains[k].p[i].uv)) return 0;
+    return 1;
+}
+
+/* |signed area| of the loop's polygon in (u,v), over the domain's area */
+static double area_fraction(const context *c, const chain *chains, int n)
+{
+    double area = 0.0;
+    const double *first = NULL, *prev = NULL;
+    for (int k = 0; k < n; ++k)
+        for (int i = 0; i < chains[k].n; ++i) {
+            const double *uv = chains[k].p[i].uv;
+            if (!first) first = uv;
+            else area += prev[0] * uv[1] - uv[0] * prev[1];
+            prev = uv;
+        }
+    if (first) area += prev[0] * first[1] - first[0] * prev[1];
+    const sem_surface *s = c->s;
+    return fabs(0.5 * area) / ((s->u1 - s->u0) * (s->v1 - s->v0));
+}
+
+static sem_status make_curve(const double *uv, int n, sem_curve *out, sem_error *err)
+{
+    if (sem_curve_alloc(out, 1, n) != SEM_OK)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim curve");
+    for (int i = 0; i < n; ++i) {
+        out->ctrl[3 * i] = uv[2 * i];
+        out->ctrl[3 * i + 1] = uv[2 * i + 1];
+        out->ctrl[3 * i + 2] = 0.0;
+    }
+    out->knots[0] = 0.0;
+    for (int i = 0; i < n; ++i) out->knots[i + 1] = (double)i;
+    out->knots[n + 1] = (double)(n - 1);
+    out->t0 = 0.0;
+    out->t1 = (double)(n - 1);
+    return SEM_OK;
+}
+
+/* Joins chain a's end to chain b's start: snap when they meet in (u,v), a connector when
+ * the gap is a collapsed edge, else an error. *connector receives the two points of a
+ * connector, *needs 1 then. */
+static sem_status join(context *c, const point *a_end, point *b_start, int *needs,
+                       double connector[4], const char *where, sem_error *err)
+{
+    const sem_surface *s = c->s;
+    double du = (b_start->uv[0] - a_end->uv[0]) / (s->u1 - s->u0);
+    double dv = (b_start->uv[1] - a_end->uv[1]) / (s->v1 - s->v0);
+    *needs = 0;
+    if (hypot(du, dv) < 1e-9) {
+        b_start->uv[0] = a_end->uv[0], b_start->uv[1] = a_end->uv[1];
+        return SEM_OK;
+    }
+    /* is the straight (u,v) segment between them a single point in space? */
+    for (int k = 1; k < 8; ++k) {
+        double uv[2] = {a_end->uv[0] + (b_start->uv[0] - a_end->uv[0]) * k / 8.0,
+                        a_end->uv[1] + (b_start->uv[1] - a_end->uv[1]) * k / 8.0};
+        double x[3];
+        sem_surface_eval(s, uv[0], uv[1], x, NULL, NULL, NULL);
+        if (dist3(x, a_end->x) > c->tol && dist3(x, b_start->x) > c->tol) {
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "the loop does not close in (u,v) %s: (%.6g, %.6g) to "
+                                 "(%.6g, %.6g)%s",
+                                 where, a_end->uv[0], a_end->uv[1], b_start->uv[0],
+                                 b_start->uv[1],
+                                 c->closed[0] || c->closed[1]
+                                     ? " (it crosses the seam of a closed surface)"
+                                     : "");
+        }
+    }
+    *needs = 1;
+    connector[0] = a_end->uv[0], connector[1] = a_end->uv[1];
+    connector[2] = b_start->uv[0], connector[3] = b_start->uv[1];
+    return SEM_OK;
+}
+
+sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_curve *curves,
+                                 int n_curves, const sem_trim_projection_settings *settings,
+                                 sem_trim_loop *out, int *border, sem_error *err)
+{
+    memset(out, 0, sizeof *out);
+    *border = 0;
+    if (n_curves < 1) return sem_error_set(err, SEM_ERR_INVALID, "empty trim loop");
+    context c;
+    memset(&c, 0, sizeof c);
+    c.sampler = sampler;
+    c.s = sampler->surface;
+    c.tol = settings->tolerance;
+    c.max_distance = settings->max_distance;
+    c.closed[0] = is_closed(c.s, 0, c.tol);
+    c.closed[1] = is_closed(c.s, 1, c.tol);
+    c.eps[0] = 1e-9 * (c.s->u1 - c.s->u0);
+    c.eps[1] = 1e-9 * (c.s->v1 - c.s->v0);
+
+    /* chain order: each curve runs from the end nearer the previous curve's end */
+    int *reverse = calloc((size_t)n_curves, sizeof *reverse);
+    chain *chains = calloc((size_t)n_curves, sizeof *chains);
+    sem_status st = SEM_OK;
+    if (!reverse || !chains) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim loop");
+        goto done;
+    }
+    double last[3];
+    for (int k = 0; k < n_curves; ++k) {
+        const sem_curve *cv = &curves[k];
+        double a[3], b[3];
+        sem_curve_eval(cv, cv->t0, a, NULL);
+        sem_curve_eval(cv, cv->t1, b, NULL);
+        if (k == 0) {
+            if (n_curves > 1) {
+                const sem_curve *nx = &curves[1];
+                double c0[3], c1[3];
+                sem_curve_eval(nx, nx->t0, c0, NULL);
+                sem_curve_eval(nx, nx->t1, c1, NULL);
+                reverse[0] = fmin(dist3(a, c0), dist3(a, c1)) < fmin(dist3(b, c0), dist3(b, c1));
+            }
+        } else {
+            reverse[k] = dist3(last, b) < dist3(last, a);
+        }
+        const double *end = reverse[k] ? a : b;
+        memcpy(last, end, sizeof last);
+    }
+
+    for (int k = 0; k < n_curves; ++k) {
+        const double *guess = k > 0 && chains[k - 1].n ? chains[k - 1].p[chains[k - 1].n - 1].uv
+                                                        : NULL;
+        if (!project_curve(&c, &curves[k], reverse[k], guess, &chains[k])) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim loop");
+            goto done;
+        }
+    }
+    if (c.worst > c.max_distance) {
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "a model-space boundary curve is %.3g away from its surface "
+                           "(allowed %.3g)",
+                           c.worst, c.max_distance);
+        goto done;
+    }
+    fix_seams_and_poles(&c, chains, n_curves);
+    if (all_on_border(&c, chains, n_curves)) {
+        /* the domain's own border: all of it, or around a closed surface (where the loop,
+         * given without the seam, cannot close in (u,v)) */
+        int wraps = c.closed[0] || c.closed[1];
+        if (wraps || fabs(area_fraction(&c, chains, n_curves) - 1.0) < 1e-6) {
+            *border = 1;
+            goto done;
+        }
+    }
+
+    /* joins, then the curves: each chain, and a connector where one is needed */
+    out->curves = calloc((size_t)(2 * n_curves), sizeof *out->curves);
+    if (!out->curves) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim loop");
+        goto done;
+    }
+    for (int k = 0; k < n_curves && st == SEM_OK; ++k) {
+        chain *ch = &chains[k];
+        chain *next = &chains[(k + 1) % n_curves];
+        double conn[4];
+        int needs = 0;
+        char where[64];
+        if (k + 1 < n_curves)
+            snprintf(where, sizeof where, "between curves %d and %d", k + 1, k + 2);
+        else
+            snprintf(where, sizeof where, "between its end and its start");
+        st = join(&c, &ch->p[ch->n - 1], &next->p[0], &needs, conn, where, err);
+        if (st != SEM_OK) break;
+        double *uv = malloc((size_t)ch->n * 2 * sizeof *uv);
+        if (!uv) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim loop");
+            break;
+        }
+        for (int i = 0; i < ch->n; ++i) uv[2 * i] = ch->p[i].uv[0], uv[2 * i + 1] = ch->p[i].uv[1];
+        if (k + 1 == n_curves && !needs) {
+            /* closed exactly: the first point of the loop may have been snapped above */
+            uv[2 * (ch->n - 1)] = chains[0].p[0].uv[0];
+            uv[2 * (ch->n - 1) + 1] = chains[0].p[0].uv[1];
+        }
+        st = make_curve(uv, ch->n, &out->curves[out->n_curves], err);
+        free(uv);
+        if (st != SEM_OK) break;
+        out->n_curves++;
+        if (needs) {
+            st = make_curve(conn, 2, &out->curves[out->n_curves], err);
+            if (st == SEM_OK) out->n_curves++;
+        }
+    }
+
+done:
+    if (st != SEM_OK && out->curves) {
+        for (int k = 0; k < out->n_curves; ++k) sem_curve_free(&out->curves[k]);
+        free(out->curves);
+        memset(out, 0, sizeof *out);
+    }
+    if (chains)
+        for (int k = 0; k < n_curves; ++k) free(chains[k].p);
+    free(chains);
+    free(reverse);
+    return st;
+}

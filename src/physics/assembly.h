@@ -1,0 +1,62 @@
+/*
+ * assembly.h - an object's energies, forces and matrices (internal to src/physics/):
+ * the elastic terms (assembly.c) and the constant mass and error matrices (mass_error.c).
+ *
+ * Design. The elastic Hessian of SEM is K = sum_p vol_p B_p^T (d2psi/dF2) B_p with
+ * B_p = sum_i w_pi (grad b_i)^T Pi_i (Eq. 15). Forming B_p over control points is wasteful:
+ * a quadrature point sees only the few parts with non-zero weight there, but through Pi
+ * each part couples every control point of the parts sharing its origin. So the work is
+ * split the way the maths factors:
+ *
+ *   1. z-space (polynomial coefficients, m per part per coordinate, written in one basis
+ *      b(X - ref) shared by all parts; see setup_stiffness in assembly.c): per point, the 3x3
+ *      deformation gradient, psi, P, d2psi/dF2 and its pull-back N_p to the shared basis;
+ *      then per *part pair* the 3m x 3m block sum_p w_a w_b N_p.
+ *   2. q-space: K_q = Pi^T K_z Pi. Pi_i's columns are exactly the control points of part
+ *      i's group (object.h), so K_q is made of dense blocks per *group pair*; each
+ *      part-pair block adds Pi_i^T K_z Pi_i' into one group-pair block with dgemm.
+ *   3. Optionally, as each group-pair block is formed (while it is in cache), its entries
+ *      are written through the system's map into the solver's values (system.h).
+ *
+ * The mass matrix M (with per-point density, Eq. 14) and the error matrix M_eps (Eq. 16)
+ * are constant and kept as scalar group-pair blocks. Error energy: gamma * sum_s a_s
+ * |Gamma_s q - J_s q|^2 = gamma q^T M_eps q, so its Hessian is 2 gamma M_eps.
+ *
+ * Every per-point Hessian is projected to positive semi-definite unless the object's
+ * exact_hessian is set (Newton near a minimum; see integrators.h).
+ *
+ * Determinism: per-thread accumulators reduced in thread order, per-pair sums in point
+ * order by one thread each; the thread count is fixed by the world definition (or
+ * OMP_NUM_THREADS).
+ */
+#ifndef SEM_PHYSICS_ASSEMBLY_H
+#define SEM_PHYSICS_ASSEMBLY_H
+
+#include "object.h"
+#include "system.h"
+
+/* assembly.c: the shared basis, the point lists of the part pairs and the work space of
+ * the elastic terms; assembly_chunk points are summed at a time (<= 0: 8192). */
+sem_status sem_assembly_init(sem_object *o, int assembly_chunk, sem_error *err);
+/* Elastic energy (into o->elastic_energy), its gradient in q (into grad_q, if not NULL)
+ * and, if want_hessian, K_blocks; with fill, the system's values of the object's group
+ * pairs too (see sem_system_fill_gpair). Fails (SEM_ERR_NUMERIC) when the energy is
+ * undefined (an inverted element, a non-finite state). */
+sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
+                                const sem_fill_target *fill, sem_error *err);
+/* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
+ * energies are translation invariant, but evaluated at q far from the origin their
+ * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
+ * slowly lose momentum conservation. Evaluating at the centred q removes that. */
+const double *sem_centered(sem_object *o, const double *q);
+
+/* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties) and their CSR
+ * copy. */
+sem_status sem_mass_error_init(sem_object *o, sem_error *err);
+/* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (into grad). */
+double sem_error_energy(sem_object *o, const double *q, double *grad);
+/* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all the object's dofs. */
+void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+                         const double *x, double *y);
+
+#endif

@@ -1,0 +1,357 @@
+/*
+ * mass_error.c - the constant matrices of an object: the mass matrix M with per-point
+ * density (Eq. 14) and the error matrix M_eps (Eq. 16), with the ties of orphan control
+ * points, as group-pair blocks (object.h) and a CSR copy; the error energy and products
+ * with the object's matrices.
+ */
+#include "assembly.h"
+
+#include <cblas.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Per-point data in z-space: w * b at X_p - Xbar_i for each weight entry (mass), and the
+ * point's part pairs. */
+static sem_status setup_points(sem_object *o, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *W = &d->W;
+    size_t n_entries = sem_csr_nnz(W);
+    int m = o->m;
+    o->entry_basis = malloc((n_entries * (size_t)m + 1) * sizeof(double));
+    o->entry_pair_offset = malloc(((size_t)o->n_quad + 1) * sizeof(int));
+    if (!o->entry_basis || !o->entry_pair_offset)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    size_t n_pp = 0;
+    o->entry_pair_offset[0] = 0;
+    for (int p = 0; p < o->n_quad; ++p) {
+        size_t k = (size_t)(W->row_start[p + 1] - W->row_start[p]);
+        n_pp += k * k;
+        o->entry_pair_offset[p + 1] = (int)n_pp;
+    }
+    o->point_pairs = malloc((n_pp + 1) * sizeof(int));
+    if (!o->point_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+#pragma omp parallel for schedule(static)
+    for (int p = 0; p < o->n_quad; ++p) {
+        const double *X = d->quad_X + 3 * (size_t)p;
+        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+        int pp = o->entry_pair_offset[p];
+        for (int r = r0; r < r1; ++r) {
+            int i = W->col[r];
+            const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+            double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]};
+            double b[10];
+            sem_polynomial_basis(o->d->order, dX, b, NULL);
+            double w = W->val[r];
+            for (int k = 0; k < m; ++k) o->entry_basis[(size_t)r * m + k] = w * b[k];
+            for (int r2 = r0; r2 < r1; ++r2)
+                o->point_pairs[pp++] = o->pair_lookup[(size_t)i * o->n_parts + W->col[r2]];
+        }
+    }
+    return SEM_OK;
+}
+
+/* Adds Pi_a^T X Pi_b for a part pair into its group-pair block. X is m x m with leading
+ * dimension ldx; block is |Ga| x |Gb| row-major; tmp has room for m x |Gb|. */
+static void add_projected(const sem_object *o, int pa, int pb, const double *X, int ldx, double *block,
+                          double *tmp)
+{
+    int m = o->m;
+    int na = (int)sem_group_size(o, o->d->part_origin[pa]), nb = (int)sem_group_size(o, o->d->part_origin[pb]);
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, m, nb, m, 1.0, X, ldx, o->pi_dense[pb],
+                nb, 0.0, tmp, nb);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, na, nb, m, 1.0, o->pi_dense[pa], na, tmp,
+                nb, 1.0, block, nb);
+}
+
+/* Constant blocks: mass with per-point density, and the error matrix. */
+static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
+{
+    int m = o->m, np = o->n_pairs;
+    double *Mz = calloc((size_t)np * m * m + 1, sizeof(double));
+    if (!Mz) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    /* Volume consistency (sem_object_def.blend): per point with weights w_i summing to S,
+     * sum_i w_i |u_i - ubar|^2 = sum_i w_i |u_i|^2 - (2 - S) |ubar|^2, u_i = b_i^T z_i,
+     * ubar = sum_j w_j u_j; in z-space the pair block (a, b) is
+     * s_p (delta_ab w_a b_a b_a^T - (2 - S) e_a e_b^T), e = w b (entry_basis). It joins the
+     * error matrix divided by gamma, since the error energy is gamma q^T E q. */
+    double blend = o->def.blend > 0 && o->d->alpha > 0 ? o->def.blend / (o->d->alpha * o->d->alpha) : 0;
+    double *Bz = blend > 0 ? calloc((size_t)np * m * m + 1, sizeof(double)) : NULL;
+    if (blend > 0 && !Bz) {
+        free(Mz);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    const sem_csr *W = &o->d->W;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double rv = o->point_rho_vol[p];
+        int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+        int pp = o->entry_pair_offset[p];
+        double S = 0, sp = 0;
+        if (Bz) {
+            for (int a = r0; a < r1; ++a) S += W->val[a];
+            sp = blend * o->point_material[p]->youngs_modulus * o->d->quad_volume[p] / o->gamma;
+        }
+        for (int a = r0; a < r1; ++a)
+            for (int b = r0; b < r1; ++b) {
+                size_t pair = (size_t)o->point_pairs[pp++];
+                double *blk = Mz + pair * m * m;
+                const double *ba = o->entry_basis + (size_t)a * m, *bb = o->entry_basis + (size_t)b * m;
+                for (int k = 0; k < m; ++k)
+                    for (int l = 0; l < m; ++l) blk[k * m + l] += rv * ba[k] * bb[l];
+                if (!Bz) continue;
+                double *bz = Bz + pair * m * m;
+                double diag = a == b && W->val[a] > 0 ? sp / W->val[a] : 0, off = sp * (2.0 - S);
+                for (int k = 0; k < m; ++k)
+                    for (int l = 0; l < m; ++l) bz[k * m + l] += (diag - off) * ba[k] * bb[l];
+            }
+    }
+    size_t mg = sem_max_group_size(o);
+    double *tmp = malloc((size_t)m * mg * sizeof(double));
+    if (!tmp) {
+        free(Mz);
+        free(Bz);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int k = 0; k < np; ++k) {
+        int g = o->part_pair_gpair[k];
+        add_projected(o, o->pair_a[k], o->pair_b[k], Mz + (size_t)k * m * m, m,
+                      o->M_blocks + o->gpair_offset[g], tmp);
+        if (Bz)
+            add_projected(o, o->pair_a[k], o->pair_b[k], Bz + (size_t)k * m * m, m,
+                          o->E_blocks + o->gpair_offset[g], tmp);
+    }
+    free(tmp);
+    free(Mz);
+    free(Bz);
+    /* Control points that no boundary sample sees (their basis functions are supported
+     * only where a trim removed the surface) appear in no term of the discretization, so
+     * the system would be singular. Each such point is tied to its own part's polynomial
+     * at its rest position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical
+     * control point's error term. It vanishes for every affine motion (the control points
+     * of an affinely mapped NURBS are affinely mapped), so the patch test is unaffected. */
+    {
+        const sem_csr *J = &o->d->J_hat;
+        double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
+        if (!colw) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int r = 0; r < J->n_rows; ++r)
+            for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
+                colw[J->col[e]] += o->d->sample_area[r] * J->val[e] * J->val[e];
+        double mean = 0;
+        for (int c = 0; c < o->n_ctrl; ++c) mean += colw[c];
+        mean /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+        double *row = malloc(mg * sizeof(double) + 1);
+        if (!row) {
+            free(colw);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        o->n_orphans = 0;
+        for (int i = 0; i < o->n_parts; ++i) {
+            int g = o->d->part_origin[i];
+            size_t n = sem_group_size(o, g);
+            int gp = o->gpair_lookup[(size_t)g * o->n_groups + g];
+            if (gp < 0) continue;
+            for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
+                if (colw[c] > 1e-10 * mean) continue;
+                const double *X = o->q0 + 3 * (size_t)c, *Xb = o->d->origin_X + 3 * (size_t)g;
+                double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
+                sem_polynomial_basis(o->d->order, dX, b, NULL);
+                for (size_t l = 0; l < n; ++l) {
+                    double v = 0;
+                    for (int k = 0; k < m; ++k) v += b[k] * o->pi_dense[i][(size_t)k * n + l];
+                    row[l] = -v;
+                }
+                row[o->ctrl_local[c]] += 1.0;
+                double *blk = o->E_blocks + o->gpair_offset[gp];
+                for (size_t a = 0; a < n; ++a)
+                    if (row[a] != 0)
+                        for (size_t bb = 0; bb < n; ++bb) blk[a * n + bb] += mean * row[a] * row[bb];
+                o->n_orphans++;
+            }
+        }
+        free(row);
+        free(colw);
+    }
+    /* Error matrix (Eq. 16) as a sum of outer products of r_s = Gamma_s - J_s, so it is
+     * positive semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J
+     * cancels large terms, and its round-off can leave small negative eigenvalues exactly in
+     * the directions the mass matrix does not see (M has rank at most the number of
+     * quadrature points per coordinate), which makes M + h^2 (K + 2 gamma M_eps) indefinite. */
+    {
+        const sem_csr *G = &o->d->Gamma_samples, *J = &o->d->J_hat;
+        int *rc = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+        double *rv = malloc(((size_t)o->n_ctrl + 1) * sizeof(double));
+        if (!rc || !rv) {
+            free(rc);
+            free(rv);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        /* A collapsed edge (a sphere's pole) has a zero area element, so its samples would
+         * drop out, and with them the only information that fixes the control points of the
+         * collapsed row: the system becomes singular. Every sample keeps at least 5% of its
+         * part's mean sample weight. */
+        double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
+        int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
+        if (!part_mean || !part_count) {
+            free(part_mean);
+            free(part_count);
+            free(rc);
+            free(rv);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        for (int r = 0; r < o->d->n_samples; ++r) {
+            part_mean[o->d->sample_part[r]] += o->d->sample_area[r];
+            part_count[o->d->sample_part[r]]++;
+        }
+        for (int i = 0; i < o->n_parts; ++i)
+            if (part_count[i]) part_mean[i] /= part_count[i];
+        for (int r = 0; r < G->n_rows; ++r) {
+            /* merge the sorted rows of Gamma_s and J_s */
+            int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
+            int n = 0;
+            while (a < ae || b < be) {
+                if (b >= be || (a < ae && G->col[a] < J->col[b])) {
+                    rc[n] = G->col[a];
+                    rv[n++] = G->val[a++];
+                } else if (a >= ae || J->col[b] < G->col[a]) {
+                    rc[n] = J->col[b];
+                    rv[n++] = -J->val[b++];
+                } else {
+                    rc[n] = G->col[a];
+                    rv[n++] = G->val[a++] - J->val[b++];
+                }
+            }
+            double area = fmax(o->d->sample_area[r], 0.05 * part_mean[o->d->sample_part[r]]);
+            for (int x = 0; x < n; ++x) {
+                int gx = o->ctrl_group[rc[x]];
+                double ax = area * rv[x];
+                if (ax == 0) continue;
+                for (int y = 0; y < n; ++y) {
+                    int gy = o->ctrl_group[rc[y]];
+                    int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
+                    if (gp < 0) {
+                        free(part_mean);
+                        free(part_count);
+                        free(rc);
+                        free(rv);
+                        return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
+                    }
+                    size_t nb = sem_group_size(o, gy);
+                    o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[rc[x]] * nb + (size_t)o->ctrl_local[rc[y]]] +=
+                        ax * rv[y];
+                }
+            }
+        }
+        free(part_mean);
+        free(part_count);
+        free(rc);
+        free(rv);
+    }
+    return SEM_OK;
+}
+
+/* M and E_blocks as CSR rows over control points, for products with them alone (the
+ * right-hand side and the error force of every step) run in parallel by rows. */
+static sem_status setup_constant_csr(sem_object *o, sem_error *err)
+{
+    int nc = o->n_ctrl;
+    o->me_start = calloc((size_t)nc + 1, sizeof(int));
+    if (!o->me_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], nb = (int)sem_group_size(o, o->gpair_b[g]);
+        for (int x = o->group_start[ga]; x < o->group_start[ga + 1]; ++x) o->me_start[o->group_ctrl[x] + 1] += nb;
+    }
+    for (int c = 0; c < nc; ++c) o->me_start[c + 1] += o->me_start[c];
+    size_t nnz = (size_t)o->me_start[nc];
+    o->me_col = malloc((nnz + 1) * sizeof(int));
+    o->me_M = malloc((nnz + 1) * sizeof(double));
+    o->me_E = malloc((nnz + 1) * sizeof(double));
+    int *fill = malloc(((size_t)nc + 1) * sizeof(int));
+    if (!o->me_col || !o->me_M || !o->me_E || !fill) {
+        free(fill);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    memcpy(fill, o->me_start, (size_t)nc * sizeof(int));
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], gb = o->gpair_b[g];
+        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb), off = o->gpair_offset[g];
+        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
+        for (size_t la = 0; la < na; ++la)
+            for (size_t lb = 0; lb < nb; ++lb) {
+                int k = fill[ca[la]]++;
+                o->me_col[k] = cb[lb];
+                o->me_M[k] = o->M_blocks[off + la * nb + lb];
+                o->me_E[k] = o->E_blocks[off + la * nb + lb];
+            }
+    }
+    free(fill);
+    return SEM_OK;
+}
+
+sem_status sem_mass_error_init(sem_object *o, sem_error *err)
+{
+    sem_status st = setup_points(o, err);
+    if (st == SEM_OK) st = setup_constant_blocks(o, err);
+    if (st == SEM_OK) st = setup_constant_csr(o, err);
+    return st;
+}
+
+double sem_error_energy(sem_object *o, const double *q, double *grad)
+{
+    const double *qc = sem_centered(o, q);
+    sem_blocks_multiply(o, 0, o->gamma, 0, 0, qc, grad);
+    double e = 0;
+    for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) e += 0.5 * qc[i] * grad[i];
+    return e;
+}
+
+void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+                            const double *x, double *y)
+{
+    if (cK == 0 && cD == 0) {
+        /* mass and error matrix only: by rows in parallel */
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            double y0 = 0, y1 = 0, y2 = 0;
+            for (int k = o->me_start[c]; k < o->me_start[c + 1]; ++k) {
+                double v = cM * o->me_M[k] + 2.0 * cE * o->me_E[k];
+                const double *xb = x + 3 * (size_t)o->me_col[k];
+                y0 += v * xb[0];
+                y1 += v * xb[1];
+                y2 += v * xb[2];
+            }
+            y[3 * (size_t)c + 0] = y0;
+            y[3 * (size_t)c + 1] = y1;
+            y[3 * (size_t)c + 2] = y2;
+        }
+        return;
+    }
+    memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
+    for (int g = 0; g < o->n_gpairs; ++g) {
+        int ga = o->gpair_a[g], gb = o->gpair_b[g];
+        size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
+        size_t off = o->gpair_offset[g];
+        const int *ca = o->group_ctrl + o->group_start[ga], *cb = o->group_ctrl + o->group_start[gb];
+        for (size_t la = 0; la < na; ++la) {
+            double *ya = y + 3 * (size_t)ca[la];
+            for (size_t lb = 0; lb < nb; ++lb) {
+                const double *xb = x + 3 * (size_t)cb[lb];
+                size_t e = la * nb + lb;
+                double s = cM * o->M_blocks[off + e] + 2.0 * cE * o->E_blocks[off + e];
+                for (int d = 0; d < 3; ++d) ya[d] += s * xb[d];
+                if ((cK != 0 || cD != 0) && ga <= gb) {
+                    /* K is kept for ga <= gb; block (gb, ga) is its transpose */
+                    const double *xa = x + 3 * (size_t)ca[la];
+                    double *yb = y + 3 * (size_t)cb[lb];
+                    for (int d1 = 0; d1 < 3; ++d1)
+                        for (int d2 = 0; d2 < 3; ++d2) {
+                            size_t idx = 9 * off + (la * 9 + (size_t)(d1 * 3 + d2)) * nb + lb;
+                            double k = cK * o->K_blocks[idx] + cD * o->K0_blocks[idx];
+                            ya[d1] += k * xb[d2];
+                            if (ga < gb) yb[d2] += k * xa[d1];
+                        }
+                }
+            }
+        }
+    }
+}

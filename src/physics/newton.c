@@ -1,0 +1,241 @@
+/*
+ * newton.c - Newton's method on a system's incremental potential (implicit Euler) or
+ * potential energy (statics), with a backtracking line search and the switch to the exact
+ * Hessian (see integrators.h).
+ *
+ * The solve works on the system's vectors: its objects' 3 n_ctrl values one after the
+ * other (system.h). The objects' own q are read at the start and written back at the end.
+ */
+#include "integrators.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "assembly.h"
+#include "loads.h"
+
+/* One solve: the world's settings, the system, and its vectors (n_dofs each). */
+typedef struct newton {
+    sem_world *w;
+    sem_system *s;
+    double h, cD;
+    int dynamic;
+    const double *qn, *qpred, *f; /* the step's start, prediction q_n + h v_n, loads */
+    double *tmp, *dq;             /* scratch */
+} newton;
+
+/* E(q) of the system (the sum over its objects); +inf where undefined (an inverted
+ * element). Uses tmp and dq as scratch. */
+static double potential(const newton *nt, const double *q)
+{
+    const sem_system *s = nt->s;
+    const sem_world *w = nt->w;
+    double h = nt->h, total = 0;
+    for (int k = 0; k < s->n_objects; ++k) {
+        sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k], n = 3 * (size_t)o->n_ctrl;
+        const double *x = q + off, *f = nt->f + off, *qpred = nt->qpred + off, *qn = nt->qn + off;
+        double *tmp = nt->tmp + off, *dq = nt->dq + off;
+        sem_error e;
+        if (sem_assemble_elastic(o, x, 0, NULL, NULL, &e) != SEM_OK) return INFINITY;
+        double E = o->elastic_energy + sem_error_energy(o, x, tmp);
+        for (size_t i = 0; i < n; ++i) E -= f[i] * x[i];
+        if (nt->dynamic) {
+            for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qpred[i];
+            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
+            for (size_t i = 0; i < n; ++i) E += 0.5 * dq[i] * tmp[i];
+            if (nt->cD > 0 || w->def.rayleigh_mass > 0) {
+                for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qn[i];
+                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, dq, tmp);
+                for (size_t i = 0; i < n; ++i) E += 0.5 * dq[i] * tmp[i];
+            }
+        }
+        total = k == 0 ? E : total + E;
+    }
+    return total;
+}
+
+/* The gradient g of E at q and, with the objects' K blocks, the Hessian's stiffness part:
+ * grad V + 2 gamma M_eps q - f + M (q - q_pred) / h^2 + damping. */
+static sem_status gradient(const newton *nt, const double *q, double *g, sem_error *err)
+{
+    const sem_system *s = nt->s;
+    const sem_world *w = nt->w;
+    double h = nt->h;
+    for (int k = 0; k < s->n_objects; ++k) {
+        sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k], n = 3 * (size_t)o->n_ctrl;
+        const double *x = q + off, *f = nt->f + off, *qpred = nt->qpred + off, *qn = nt->qn + off;
+        double *gk = g + off, *tmp = nt->tmp + off, *dq = nt->dq + off;
+        sem_status st = sem_assemble_elastic(o, x, 1, gk, NULL, err);
+        if (st != SEM_OK) return st;
+        sem_error_energy(o, x, tmp);
+        for (size_t i = 0; i < n; ++i) gk[i] += tmp[i] - f[i];
+        if (nt->dynamic) {
+            for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qpred[i];
+            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
+            for (size_t i = 0; i < n; ++i) gk[i] += tmp[i];
+            if (nt->cD > 0 || w->def.rayleigh_mass > 0) {
+                for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qn[i];
+                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, dq, tmp);
+                for (size_t i = 0; i < n; ++i) gk[i] += tmp[i];
+            }
+        }
+    }
+    return SEM_OK;
+}
+
+static void set_exact_hessian(sem_system *s, int on)
+{
+    for (int k = 0; k < s->n_objects; ++k) s->objects[k]->exact_hessian = on;
+}
+
+/* Fills the system's matrix with the Hessian, factorizes it and counts that. */
+static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, sem_error *err)
+{
+    sem_system_fill(s, cM, 1.0, 1.0, cD);
+    sem_status st = sem_system_factorize(s, err);
+    w->last_factor_s += sem_system_factor_seconds(s);
+    w->counters.factorizations++;
+    return st;
+}
+
+sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, int max_iterations,
+                            sem_error *err)
+{
+    size_t n = s->n_dofs;
+    int dynamic = h > 0;
+    double cM = dynamic ? 1.0 / (h * h) + w->def.rayleigh_mass / h : 0.0;
+    double cD = dynamic ? w->def.rayleigh_stiffness / h : 0.0;
+    double *q = malloc(n * sizeof(double) + 1);
+    double *qn = malloc(n * sizeof(double) + 1), *qpred = malloc(n * sizeof(double) + 1);
+    double *f = malloc(n * sizeof(double) + 1), *g = malloc(n * sizeof(double) + 1);
+    double *tmp = malloc(n * sizeof(double) + 1), *dq = calloc(n + 1, sizeof(double));
+    double *qtry = malloc(n * sizeof(double) + 1), *dir = malloc(n * sizeof(double) + 1);
+    double *fr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
+    sem_status st = SEM_OK;
+    int gathered = 0;
+    if (!q || !qn || !qpred || !f || !g || !tmp || !dq || !qtry || !dir || !fr) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k], no = 3 * (size_t)o->n_ctrl;
+        memcpy(q + off, o->q, no * sizeof(double));
+        memcpy(qn + off, o->q, no * sizeof(double));
+        for (size_t i = 0; i < no; ++i) qpred[off + i] = o->q[i] + (dynamic ? h * o->v[i] : 0);
+        sem_external_force(o, t1, f + off);
+        /* pinned points go to their prescribed positions at t1, free ones (dynamics) to
+         * the prediction */
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            double *x = q + off + 3 * (size_t)c;
+            if (o->pinned[c])
+                sem_prescribed_position(o, t1, c, x);
+            else if (dynamic)
+                memcpy(x, qpred + off + 3 * (size_t)c, 3 * sizeof(double));
+        }
+    }
+    gathered = 1;
+    const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
+
+    double g0norm = -1;
+    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian;
+    set_exact_hessian(s, 0);
+    for (it = 0; it < max_iterations; ++it) {
+        /* the exact Hessian after two full steps in a row (see integrators.h) */
+        int exact = exact_allowed && full_steps >= 2;
+        set_exact_hessian(s, exact);
+        if ((st = gradient(&nt, q, g, err)) != SEM_OK) goto done;
+        sem_system_gather_free(s, g, fr);
+        double gnorm = 0, fscale = 0;
+        for (int i = 0; i < 3 * s->n_free; ++i) gnorm += fr[i] * fr[i];
+        gnorm = sqrt(gnorm);
+        for (size_t i = 0; i < n; ++i) fscale += f[i] * f[i];
+        fscale = sqrt(fscale);
+        if (g0norm < 0) g0norm = gnorm;
+        double scale = fmax(g0norm, fscale);
+        if (s->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) break;
+        st = factorize(w, s, cM, cD, err);
+        if (st == SEM_ERR_NUMERIC && exact) {
+            /* the exact system is not positive definite (e.g. a buckled or unstable
+             * equilibrium): project, for the rest of this solve */
+            set_exact_hessian(s, 0);
+            exact_allowed = 0;
+            w->counters.exact_hessian_fallbacks++;
+            for (int k = 0; k < s->n_objects; ++k)
+                if ((st = sem_assemble_elastic(s->objects[k], q + s->dof_offset[k], 1, NULL, NULL,
+                                               err)) != SEM_OK)
+                    goto done;
+            st = factorize(w, s, cM, cD, err);
+        }
+        if (st != SEM_OK) goto done;
+        if ((st = sem_system_solve(s, fr, fr, err)) != SEM_OK) goto done;
+        memset(dir, 0, n * sizeof(double));
+        sem_system_scatter_free(s, fr, dir);
+        double slope = 0;
+        for (size_t i = 0; i < n; ++i) slope -= dir[i] * g[i];
+        double E0 = potential(&nt, q);
+        double step = 1.0, Et = INFINITY;
+        for (int ls = 0; ls < 40; ++ls) {
+            for (size_t i = 0; i < n; ++i) qtry[i] = q[i] - step * dir[i];
+            Et = potential(&nt, qtry);
+            if (Et <= E0 + 1e-4 * step * slope || (isfinite(Et) && fabs(Et - E0) <= 1e-14 * fabs(E0)))
+                break;
+            step *= 0.5;
+        }
+        full_steps = step == 1.0 ? full_steps + 1 : 0;
+        double dmax = 0;
+        for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
+        if (w->def.advanced.trace_newton && w->def.log) {
+            char line[256];
+            snprintf(line, sizeof line, "newton it %d: |g| %.6g E0 %.12g Et %.12g step %g slope %g dmax %g", it,
+                     gnorm, E0, Et, step, slope, dmax);
+            w->def.log(w->def.log_user, 0, line);
+        }
+        if (!isfinite(Et)) {
+            st = sem_error_set(err, SEM_ERR_NUMERIC,
+                               "Newton line search found no valid configuration at t = %g", t1);
+            goto done;
+        }
+        memcpy(q, qtry, n * sizeof(double));
+        if (dmax <= 1e-14 * (1.0 + fabs(q[0]))) {
+            ++it;
+            break;
+        }
+    }
+    w->last_iterations = it;
+    w->counters.newton_iterations += it;
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(q[i])) {
+            st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
+            goto done;
+        }
+    for (int k = 0; k < s->n_objects; ++k) {
+        sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k], no = 3 * (size_t)o->n_ctrl;
+        if (dynamic)
+            for (size_t i = 0; i < no; ++i) o->v[i] = (q[off + i] - qn[off + i]) / h;
+        else
+            memset(o->v, 0, no * sizeof(double));
+    }
+done:
+    set_exact_hessian(s, 0);
+    /* the objects take the last iterate, also when the solve failed */
+    if (gathered)
+        for (int k = 0; k < s->n_objects; ++k)
+            memcpy(s->objects[k]->q, q + s->dof_offset[k], 3 * (size_t)s->objects[k]->n_ctrl * sizeof(double));
+    free(q);
+    free(qn);
+    free(qpred);
+    free(f);
+    free(g);
+    free(tmp);
+    free(dq);
+    free(qtry);
+    free(dir);
+    free(fr);
+    return st;
+}

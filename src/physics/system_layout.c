@@ -1,0 +1,268 @@
+/*
+ * system_layout.c - free dofs, the sparse pattern of a set of objects' system and the maps
+ * from their blocks into it; filling, factorizing and solving (see system.h).
+ */
+#include "system.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+sem_status sem_object_free_dofs(sem_object *o, sem_error *err)
+{
+    o->free_index = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+    if (!o->free_index) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    o->n_free = 0;
+    for (int c = 0; c < o->n_ctrl; ++c) o->free_index[c] = o->pinned[c] ? -1 : o->n_free++;
+    return SEM_OK;
+}
+
+/* Visits every entry of the objects' K blocks (9 per scalar entry). pass 0 counts the
+ * entries of each column of the upper triangle (count[c + 1]); pass 1 writes each entry's
+ * row into rows at fill[c] and its position into the object's map (-1: not in the upper
+ * triangle of the free dofs). */
+static void visit_entries(sem_system *s, int pass, int *count, int *rows, int *fill)
+{
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        int *map = s->map[k];
+        int first = s->free_offset[k];
+        for (int g = 0; g < o->n_gpairs; ++g) {
+            int ga = o->gpair_a[g], gb = o->gpair_b[g];
+            size_t na = sem_group_size(o, ga), nb = sem_group_size(o, gb);
+            for (size_t la = 0; la < na; ++la) {
+                int fa = o->free_index[o->group_ctrl[o->group_start[ga] + la]];
+                for (size_t lb = 0; lb < nb; ++lb) {
+                    int fb = o->free_index[o->group_ctrl[o->group_start[gb] + lb]];
+                    for (int dd = 0; dd < 9; ++dd) {
+                        int d1 = dd / 3, d2 = dd % 3;
+                        size_t idx = 9 * o->gpair_offset[g] + (la * 9 + (size_t)dd) * nb + lb;
+                        if (fa < 0 || fb < 0) {
+                            if (pass == 1) map[idx] = -1;
+                            continue;
+                        }
+                        int r = 3 * (first + fa) + d1, c = 3 * (first + fb) + d2;
+                        if (ga > gb || (ga == gb && r > c)) {
+                            if (pass == 1) map[idx] = -1;
+                            continue;
+                        }
+                        if (r > c) {
+                            int x = r;
+                            r = c;
+                            c = x;
+                        }
+                        if (pass == 0)
+                            count[c + 1]++;
+                        else {
+                            rows[fill[c]] = r;
+                            map[idx] = fill[c]++;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* CSC pattern of the free dofs (upper triangle), the maps and the solver. */
+static sem_status build_pattern(sem_system *s, sem_solver_choice choice, sem_error *err)
+{
+    int nf = 3 * s->n_free;
+    sem_status st = SEM_OK;
+    int *count = calloc((size_t)nf + 1, sizeof(int));
+    int *rows = NULL, *fill = NULL, *perm = NULL, *inv = NULL, *sorted = NULL;
+    if (!count) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        s->map[k] = malloc((9 * o->gpair_offset[o->n_gpairs] + 1) * sizeof(int));
+        if (!s->map[k]) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+            goto done;
+        }
+    }
+    visit_entries(s, 0, count, NULL, NULL);
+    for (int c = 0; c < nf; ++c) count[c + 1] += count[c];
+    rows = malloc(((size_t)count[nf] + 1) * sizeof(int));
+    fill = malloc(((size_t)nf + 1) * sizeof(int));
+    if (!rows || !fill) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+        goto done;
+    }
+    memcpy(fill, count, (size_t)nf * sizeof(int));
+    visit_entries(s, 1, count, rows, fill);
+    /* Each (r,c) occurs once: group pairs are distinct, a control point is in one group and
+     * objects have disjoint dofs. Sort rows within columns and remap positions. */
+    perm = malloc(((size_t)count[nf] + 1) * sizeof(int));
+    inv = malloc(((size_t)count[nf] + 1) * sizeof(int));
+    sorted = malloc(((size_t)count[nf] + 1) * sizeof(int));
+    if (!perm || !inv || !sorted) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (int c = 0; c < nf; ++c) {
+        int a = count[c], b = count[c + 1];
+        /* insertion sort is fine for short columns; use counting by row otherwise */
+        for (int k = a; k < b; ++k) perm[k] = k;
+        for (int k = a + 1; k < b; ++k) {
+            int x = perm[k], j = k - 1;
+            while (j >= a && rows[perm[j]] > rows[x]) {
+                perm[j + 1] = perm[j];
+                --j;
+            }
+            perm[j + 1] = x;
+        }
+        for (int k = a; k < b; ++k) inv[perm[k]] = k;
+    }
+    for (int k = 0; k < count[nf]; ++k) sorted[inv[k]] = rows[k];
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        size_t n = 9 * o->gpair_offset[o->n_gpairs];
+        for (size_t e = 0; e < n; ++e)
+            if (s->map[k][e] >= 0) s->map[k][e] = inv[s->map[k][e]];
+    }
+    st = sem_linear_solver_create(nf, count, sorted, choice, &s->solver, err);
+    if (st == SEM_OK)
+        for (int k = 0; k < s->n_objects; ++k) {
+            const sem_object *o = s->objects[k];
+            sem_linear_solver_remap(s->solver, s->map[k], 9 * o->gpair_offset[o->n_gpairs]);
+        }
+done:
+    free(sorted);
+    free(perm);
+    free(inv);
+    free(rows);
+    free(fill);
+    free(count);
+    return st;
+}
+
+sem_status sem_system_create(sem_object **objects, int n_objects, sem_solver_choice choice,
+                             sem_system **out, sem_error *err)
+{
+    *out = NULL;
+    sem_system *s = calloc(1, sizeof *s);
+    if (!s) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    size_t n = n_objects > 0 ? (size_t)n_objects : 1;
+    s->n_objects = n_objects;
+    s->objects = malloc(n * sizeof *s->objects);
+    s->free_offset = calloc(n + 1, sizeof *s->free_offset);
+    s->dof_offset = calloc(n + 1, sizeof *s->dof_offset);
+    s->map = calloc(n, sizeof *s->map);
+    if (!s->objects || !s->free_offset || !s->dof_offset || !s->map) {
+        sem_system_destroy(s);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int k = 0; k < n_objects; ++k) {
+        sem_object *o = objects[k];
+        s->objects[k] = o;
+        s->free_offset[k + 1] = s->free_offset[k] + o->n_free;
+        s->dof_offset[k + 1] = s->dof_offset[k] + 3 * (size_t)o->n_ctrl;
+    }
+    s->n_free = s->free_offset[n_objects];
+    s->n_dofs = s->dof_offset[n_objects];
+    if (s->n_free > 0) {
+        sem_status st = build_pattern(s, choice, err);
+        if (st != SEM_OK) {
+            sem_system_destroy(s);
+            return st;
+        }
+    }
+    for (int k = 0; k < n_objects; ++k) objects[k]->system = s;
+    *out = s;
+    return SEM_OK;
+}
+
+void sem_system_destroy(sem_system *s)
+{
+    if (!s) return;
+    if (s->map)
+        for (int k = 0; k < s->n_objects; ++k) free(s->map[k]);
+    free(s->map);
+    sem_linear_solver_destroy(s->solver);
+    free(s->objects);
+    free(s->free_offset);
+    free(s->dof_offset);
+    free(s);
+}
+
+void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], double *val)
+{
+    const sem_object *o = s->objects[k];
+    if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see system.h) */
+    size_t na = sem_group_size(o, o->gpair_a[g]), nb = sem_group_size(o, o->gpair_b[g]);
+    size_t off = o->gpair_offset[g];
+    for (size_t la = 0; la < na; ++la) {
+        const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
+        for (int dd = 0; dd < 9; ++dd) {
+            int diag = dd / 3 == dd % 3;
+            size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
+            const int *map = s->map[k] + row;
+            const double *K = o->K_blocks + row, *K0 = o->K0_blocks + row;
+            for (size_t lb = 0; lb < nb; ++lb) {
+                int pos = map[lb];
+                if (pos < 0) continue;
+                double v = c[2] * K[lb] + c[3] * K0[lb];
+                if (diag) v += c[0] * Ms[lb] + 2.0 * c[1] * Es[lb];
+                val[pos] = v;
+            }
+        }
+    }
+}
+
+void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD)
+{
+    double *val = sem_linear_solver_values(s->solver);
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        const double c[4] = {cM, cE * o->gamma, cK, cD};
+#pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
+        for (int g = 0; g < o->n_gpairs; ++g) sem_system_fill_gpair(s, k, g, c, val);
+    }
+}
+
+double *sem_system_values(sem_system *s)
+{
+    return s->solver ? sem_linear_solver_values(s->solver) : NULL;
+}
+
+sem_status sem_system_factorize(sem_system *s, sem_error *err)
+{
+    return sem_linear_solver_factorize(s->solver, err);
+}
+
+double sem_system_factor_seconds(const sem_system *s)
+{
+    return sem_linear_solver_last_factor_seconds(s->solver);
+}
+
+sem_status sem_system_solve(sem_system *s, const double *b, double *x, sem_error *err)
+{
+    return sem_linear_solver_solve(s->solver, b, x, err);
+}
+
+void sem_system_gather_free(const sem_system *s, const double *full, double *free_values)
+{
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        const double *x = full + s->dof_offset[k];
+        double *y = free_values + 3 * (size_t)s->free_offset[k];
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            int f = o->free_index[c];
+            if (f < 0) continue;
+            for (int d = 0; d < 3; ++d) y[3 * f + d] = x[3 * c + d];
+        }
+    }
+}
+
+void sem_system_scatter_free(const sem_system *s, const double *free_values, double *full)
+{
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        const double *y = free_values + 3 * (size_t)s->free_offset[k];
+        double *x = full + s->dof_offset[k];
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            int f = o->free_index[c];
+            if (f < 0) continue;
+            for (int d = 0; d < 3; ++d) x[3 * c + d] = y[3 * f + d];
+        }
+    }
+}

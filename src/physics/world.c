@@ -1,0 +1,391 @@
+/*
+ * world.c - the world API (sem/simulation.h): definitions with defaults, creating and
+ * destroying worlds, adding objects (materials, state, and the setup of every other
+ * physics file in turn), queries and statistics. Stepping is in integrators.c.
+ *
+ * Where the simulator lives (paper Sec. 7, Alg. 2; design notes in docs/simulation.md):
+ *   object.h         an object and the block structure of its matrices (object_layout.c)
+ *   assembly.h       its elastic terms (assembly.c), mass and error matrices (mass_error.c)
+ *   loads.h          gravity, region and point loads, prescribed motion (loads.c)
+ *   system.h         free dofs, the sparse system of a set of objects, solves
+ *                    (system_layout.c over linear_solver.c)
+ *   integrators.h    linearly implicit Euler (integrators.c), Newton for implicit Euler
+ *                    and statics (newton.c)
+ *   world.h          the world: settings, objects, systems, clock, counters
+ */
+#include "world.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "assembly.h"
+#include "loads.h"
+#include "system.h"
+
+sem_world_def sem_default_world_def(void)
+{
+    sem_world_def d;
+    memset(&d, 0, sizeof d);
+    d.gravity[2] = -9.81;
+    d.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    d.dt = 0.01;
+    d.newton_tolerance = 1e-8;
+    d.newton_max_iterations = 50;
+    d.solver = SEM_SOLVER_AUTO;
+    return d;
+}
+
+sem_object_def sem_default_object_def(void)
+{
+    sem_object_def d;
+    memset(&d, 0, sizeof d);
+    d.material = sem_default_material();
+    d.blend = SEM_DEFAULT_BLEND;
+    return d;
+}
+
+sem_world *sem_world_create(const sem_world_def *def, sem_error *err)
+{
+    if (!(def->dt > 0) || !isfinite(def->dt)) {
+        sem_error_set(err, SEM_ERR_INVALID, "time step dt must be positive (got %g)", def->dt);
+        return NULL;
+    }
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(def->gravity[k])) {
+            sem_error_set(err, SEM_ERR_INVALID, "gravity must be finite");
+            return NULL;
+        }
+    if (def->rayleigh_mass < 0 || def->rayleigh_stiffness < 0) {
+        sem_error_set(err, SEM_ERR_INVALID, "Rayleigh damping coefficients must be >= 0");
+        return NULL;
+    }
+    sem_world *w = calloc(1, sizeof *w);
+    if (!w) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    w->def = *def;
+    if (w->def.newton_tolerance <= 0) w->def.newton_tolerance = 1e-8;
+    if (w->def.newton_max_iterations <= 0) w->def.newton_max_iterations = 50;
+    return w;
+}
+
+static void object_destroy(sem_object *o)
+{
+    if (!o) return;
+    free(o->q);
+    free(o->v);
+    free(o->q0);
+    free(o->point_material);
+    free(o->point_rho_vol);
+    free(o->entry_basis);
+    free(o->entry_pair_offset);
+    free(o->part_mats);
+    free(o->point_pairs);
+    free(o->pair_a);
+    free(o->pair_b);
+    free(o->pair_lookup);
+    free(o->group_start);
+    free(o->group_ctrl);
+    free(o->ctrl_group);
+    free(o->ctrl_local);
+    if (o->pi_dense)
+        for (int i = 0; i < o->n_parts; ++i) free(o->pi_dense[i]);
+    free(o->pi_dense);
+    if (o->pi_shared)
+        for (int i = 0; i < o->n_parts; ++i) free(o->pi_shared[i]);
+    free(o->pi_shared);
+    free(o->point_D);
+    free(o->plist_start);
+    free(o->plist_point);
+    free(o->plist_w);
+    free(o->plist_cursor);
+    free(o->N_chunk);
+    free(o->Kz_packed);
+    free(o->gpair_a);
+    free(o->gpair_b);
+    free(o->gpair_lookup);
+    free(o->gpair_offset);
+    free(o->part_pair_gpair);
+    free(o->gpair_pairs_start);
+    free(o->gpair_pairs);
+    free(o->K_blocks);
+    free(o->M_blocks);
+    free(o->E_blocks);
+    free(o->me_start);
+    free(o->me_col);
+    free(o->me_M);
+    free(o->me_E);
+    free(o->K0_blocks);
+    free(o->f_gravity);
+    free(o->pinned);
+    free(o->presc_index);
+    free(o->presc);
+    free(o->free_index);
+    free(o->z);
+    free(o->grad_z);
+    free(o->Kz);
+    free(o->qc);
+    free(o->grad_z_thread);
+    free((void *)o->def.point_loads);
+    free((void *)o->def.region_loads);
+    free(o);
+}
+
+void sem_world_destroy(sem_world *w)
+{
+    if (!w) return;
+    for (int i = 0; i < w->n_systems; ++i) sem_system_destroy(w->systems[i]);
+    for (int i = 0; i < w->n_objects; ++i) object_destroy(w->objects[i]);
+    free(w->objects);
+    free(w->systems);
+    free(w);
+}
+
+static const sem_material *material_of_part(const sem_object *o, const sem_object_def *def, int part)
+{
+    if (def->part_material && o->part_mats) {
+        int k = def->part_material[part];
+        if (k >= 0 && k < def->n_part_materials) return &o->part_mats[k];
+    }
+    return &o->def.material;
+}
+
+int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
+{
+    if (!def->model || !def->disc) {
+        sem_error_set(err, SEM_ERR_INVALID, "object needs a model and its discretization");
+        return -1;
+    }
+    const sem_discretization *d = def->disc;
+    if ((size_t)d->n_ctrl != sem_model_control_points(def->model) || d->n_parts != def->model->n_parts) {
+        sem_error_set(err, SEM_ERR_INVALID, "discretization does not match the model");
+        return -1;
+    }
+    sem_object *o = calloc(1, sizeof *o);
+    sem_system *sys;
+    if (!o) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    o->def = *def;
+    /* the caller's arrays are copied where needed; keep no pointer to them */
+    o->def.pinned = NULL;
+    o->def.prescribe_group = NULL;
+    o->def.prescribes = NULL;
+    o->def.point_loads = NULL;
+    o->def.region_loads = NULL;
+    o->def.n_point_loads = 0;
+    o->def.n_region_loads = 0;
+    o->d = d;
+    o->n_ctrl = d->n_ctrl;
+    o->n_parts = d->n_parts;
+    o->m = d->n_basis;
+    o->n_quad = d->n_quad;
+    size_t nq = 3 * (size_t)o->n_ctrl;
+    sem_status st = SEM_OK;
+    o->q = malloc(nq * sizeof(double));
+    o->v = calloc(nq, sizeof(double));
+    o->q0 = malloc(nq * sizeof(double));
+    o->f_gravity = calloc(nq, sizeof(double));
+    o->point_material = malloc(((size_t)o->n_quad + 1) * sizeof(*o->point_material));
+    o->point_rho_vol = malloc(((size_t)o->n_quad + 1) * sizeof(double));
+    o->z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double));
+    o->grad_z = calloc((size_t)o->n_parts * o->m * 3, sizeof(double)); /* room for ma rows */
+    if (!o->q || !o->v || !o->q0 || !o->f_gravity || !o->point_material || !o->point_rho_vol ||
+        !o->z || !o->grad_z) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    /* materials */
+    {
+        sem_material mat = def->material;
+        if ((st = sem_material_init(&mat, err)) != SEM_OK) goto fail;
+        o->def.material = mat;
+        /* the object keeps initialized copies: the caller's array need not outlive this
+         * call, and its Lame parameters need not be set */
+        if (def->part_materials && def->n_part_materials > 0) {
+            o->part_mats = malloc((size_t)def->n_part_materials * sizeof *o->part_mats);
+            if (!o->part_mats) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+            for (int k = 0; k < def->n_part_materials; ++k) {
+                o->part_mats[k] = def->part_materials[k];
+                if ((st = sem_material_init(&o->part_mats[k], err)) != SEM_OK) goto fail;
+            }
+        }
+    }
+    sem_model_get_q(def->model, o->q0);
+    memcpy(o->q, o->q0, nq * sizeof(double));
+    o->volume = 0;
+    o->mass = 0;
+    for (int p = 0; p < o->n_quad; ++p) {
+        int part = d->quad_part ? d->quad_part[p] : 0;
+        if (part < 0 || part >= o->n_parts) part = 0;
+        const sem_material *mt = material_of_part(o, def, part);
+        o->point_material[p] = mt;
+        o->point_rho_vol[p] = mt->density * d->quad_volume[p];
+        o->volume += d->quad_volume[p];
+        o->mass += o->point_rho_vol[p];
+    }
+    o->def.part_material = NULL; /* the caller's arrays: read above, not kept */
+    o->def.part_materials = NULL;
+    if ((st = sem_loads_init(o, def, err)) != SEM_OK) goto fail;
+    if ((st = sem_object_free_dofs(o, err)) != SEM_OK) goto fail;
+    /* error stiffness: the object's, else the discretization's default */
+    o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
+    if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
+    if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
+    if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;
+    o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
+    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
+    o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
+    if (!o->qc || !o->grad_z_thread) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
+    /* rest stiffness for Rayleigh damping */
+    if ((st = sem_assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
+    memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
+    /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
+    {
+        double com[3] = {0, 0, 0};
+        if (o->mass > 0) {
+            double *xp = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+            if (!xp) {
+                sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+            sem_csr_multiply(&d->Gamma, o->q, 3, xp);
+            for (int p = 0; p < o->n_quad; ++p)
+                for (int k = 0; k < 3; ++k) com[k] += o->point_rho_vol[p] * xp[3 * p + k];
+            for (int k = 0; k < 3; ++k) com[k] /= o->mass;
+            free(xp);
+        }
+        const double *v0 = def->initial_velocity, *om = def->initial_angular_velocity;
+        for (int c = 0; c < o->n_ctrl; ++c) {
+            if (o->pinned[c]) continue;
+            const double *x = o->q + 3 * c;
+            double r[3] = {x[0] - com[0], x[1] - com[1], x[2] - com[2]};
+            o->v[3 * c + 0] = v0[0] + om[1] * r[2] - om[2] * r[1];
+            o->v[3 * c + 1] = v0[1] + om[2] * r[0] - om[0] * r[2];
+            o->v[3 * c + 2] = v0[2] + om[0] * r[1] - om[1] * r[0];
+        }
+    }
+    if (w->n_objects == w->cap) {
+        int nc = w->cap ? 2 * w->cap : 4;
+        sem_object **x = realloc(w->objects, (size_t)nc * sizeof *x);
+        if (x) w->objects = x;
+        sem_system **y = x ? realloc(w->systems, (size_t)nc * sizeof *y) : NULL;
+        if (y) w->systems = y;
+        if (!x || !y) {
+            sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        w->cap = nc;
+    }
+    /* its system: of its own, or (solve_together) the one system of every object, built
+     * again with the new one */
+    w->objects[w->n_objects] = o;
+    if (w->def.advanced.solve_together && w->n_systems == 1) {
+        if ((st = sem_system_create(w->objects, w->n_objects + 1, w->def.solver, &sys, err)) != SEM_OK)
+            goto fail;
+        sem_system_destroy(w->systems[0]);
+        w->systems[0] = sys;
+    } else {
+        if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
+        w->systems[w->n_systems++] = sys;
+    }
+    return w->n_objects++;
+fail:
+    object_destroy(o);
+    return -1;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* queries                                                                             */
+
+double sem_world_time(const sem_world *w) { return w->time; }
+int sem_world_object_count(const sem_world *w) { return w->n_objects; }
+int sem_world_object_dofs(const sem_world *w, int i) { return 3 * w->objects[i]->n_ctrl; }
+const double *sem_world_object_q(const sem_world *w, int i) { return w->objects[i]->q; }
+const double *sem_world_object_velocity(const sem_world *w, int i) { return w->objects[i]->v; }
+double sem_world_last_step_seconds(const sem_world *w) { return w->last_step_s; }
+double sem_world_last_factor_seconds(const sem_world *w) { return w->last_factor_s; }
+int sem_world_last_iterations(const sem_world *w) { return w->last_iterations; }
+sem_world_counters sem_world_get_counters(const sem_world *w) { return w->counters; }
+
+const char *sem_world_solver_name(const sem_world *w, int i)
+{
+    const sem_linear_solver *solver = w->objects[i]->system->solver;
+    return solver ? sem_linear_solver_name(solver) : "none";
+}
+
+double sem_world_object_nnz_percent(const sem_world *w, int i)
+{
+    const sem_object *o = w->objects[i];
+    /* full q-space pattern: group-pair blocks x 9 */
+    double nnz = 9.0 * (double)o->gpair_offset[o->n_gpairs];
+    double n = 3.0 * o->n_ctrl;
+    return 100.0 * nnz / (n * n);
+}
+
+void sem_world_object_set_state(sem_world *w, int i, const double *q, const double *v)
+{
+    sem_object *o = w->objects[i];
+    size_t n = 3 * (size_t)o->n_ctrl;
+    if (q) memcpy(o->q, q, n * sizeof(double));
+    if (v) memcpy(o->v, v, n * sizeof(double));
+}
+
+void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
+{
+    sem_object *o = w->objects[i];
+    const sem_discretization *d = o->d;
+    memset(s, 0, sizeof *s);
+    s->volume = o->volume;
+    s->mass = o->mass;
+    size_t n = 3 * (size_t)o->n_ctrl;
+    double *x = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+    double *v = malloc(3 * (size_t)o->n_quad * sizeof(double) + 1);
+    double *tmp = malloc(n * sizeof(double) + 1);
+    if (!x || !v || !tmp) {
+        free(x);
+        free(v);
+        free(tmp);
+        return;
+    }
+    sem_csr_multiply(&d->Gamma, o->q, 3, x);
+    sem_csr_multiply(&d->Gamma, o->v, 3, v);
+    const double *g = w->def.gravity;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double rv = o->point_rho_vol[p];
+        const double *xp = x + 3 * p, *vp = v + 3 * p;
+        for (int k = 0; k < 3; ++k) {
+            s->center_of_mass[k] += rv * xp[k];
+            s->linear_momentum[k] += rv * vp[k];
+        }
+        s->angular_momentum[0] += rv * (xp[1] * vp[2] - xp[2] * vp[1]);
+        s->angular_momentum[1] += rv * (xp[2] * vp[0] - xp[0] * vp[2]);
+        s->angular_momentum[2] += rv * (xp[0] * vp[1] - xp[1] * vp[0]);
+        s->gravity_energy -= rv * (g[0] * xp[0] + g[1] * xp[1] + g[2] * xp[2]);
+    }
+    if (o->mass > 0)
+        for (int k = 0; k < 3; ++k) s->center_of_mass[k] /= o->mass;
+    /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
+    sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
+    for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
+    s->error_energy = sem_error_energy(o, o->q, tmp);
+    sem_error e;
+    if (sem_assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK)
+        s->elastic_energy = o->elastic_energy;
+    else
+        s->elastic_energy = INFINITY;
+    free(x);
+    free(v);
+    free(tmp);
+}
