@@ -56,6 +56,10 @@ typedef struct sem_world_def {
     int newton_max_iterations; /* default 50 (static: 200) */
     sem_solver_choice solver;
     int threads;               /* 0: OpenMP default */
+    int accept_unconverged;    /* 1: a Newton solve that misses its tolerance within
+                                  newton_max_iterations keeps its last iterate (counted in
+                                  sem_world_counters.unconverged_solves, logged); 0 (default):
+                                  it fails with SEM_ERR_NUMERIC */
     sem_world_log_fn log;      /* may be NULL */
     void *log_user;
     sem_world_advanced advanced;
@@ -192,6 +196,8 @@ typedef struct sem_world_counters {
                                      tries both solvers on the first one: counted once) */
     long exact_hessian_fallbacks; /* Newton solves whose exact Hessian was not positive
                                      definite, so that went back to the projected one */
+    long unconverged_solves;      /* Newton solves kept without reaching the tolerance
+                                     (sem_world_def.accept_unconverged) */
 } sem_world_counters;
 
 sem_world_counters sem_world_get_counters(const sem_world *world);

@@ -124,7 +124,7 @@ class sem_world_def(Structure):
     _fields_ = [("gravity", c_double * 3), ("integrator", c_int), ("dt", c_double),
                 ("rayleigh_mass", c_double), ("rayleigh_stiffness", c_double),
                 ("newton_tolerance", c_double), ("newton_max_iterations", c_int),
-                ("solver", c_int), ("threads", c_int), ("log", c_void_p),
+                ("solver", c_int), ("threads", c_int), ("accept_unconverged", c_int), ("log", c_void_p),
                 ("log_user", c_void_p), ("advanced", sem_world_advanced)]
 
 

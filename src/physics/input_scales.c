@@ -27,7 +27,14 @@
 #define MAX_STIFFNESS_RATIO 1e15
 #define MAX_LOAD_RATIO 1e6
 
-static double norm3(const double *v) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+/* |v| without overflow for components near the largest doubles (a 1e200 N load) */
+static double norm3(const double *v)
+{
+    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    if (!(m > 0) || !isfinite(m)) return m;
+    double a = v[0] / m, b = v[1] / m, c = v[2] / m;
+    return m * sqrt(a * a + b * b + c * c);
+}
 
 static sem_status check_material(const sem_world_def *w, const sem_object_def *o,
                                  const sem_material *m, const char *which, double L, double V,

@@ -11,6 +11,7 @@
 
 #include "assembly.h"
 #include "loads.h"
+#include "runaway.h"
 
 /* (M + h C + h^2 K) v+ = M v + h f(q), q+ = q + h v+ (the paper's step), over the system's
  * vectors (its objects' values one after the other). */
@@ -104,6 +105,10 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
         }
         if (st != SEM_OK) return st;
     }
+    for (int k = 0; k < w->n_objects; ++k) {
+        sem_status st = sem_runaway_check(w->objects[k], w->def.integrator == SEM_STATIC, t1, err);
+        if (st != SEM_OK) return st;
+    }
     w->time += w->def.dt;
     w->step_index++;
     w->counters.steps++;
@@ -116,6 +121,10 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
     int max_iterations = w->def.newton_max_iterations < 200 ? 200 : w->def.newton_max_iterations;
     for (int i = 0; i < w->n_systems; ++i) {
         sem_status st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);
+        if (st != SEM_OK) return st;
+    }
+    for (int k = 0; k < w->n_objects; ++k) {
+        sem_status st = sem_runaway_check(w->objects[k], 1, w->time, err);
         if (st != SEM_OK) return st;
     }
     return SEM_OK;

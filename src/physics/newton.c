@@ -141,8 +141,8 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     gathered = 1;
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
 
-    double g0norm = -1;
-    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian;
+    double g0norm = -1, last_rel = 0;
+    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0;
     set_exact_hessian(s, 0);
     for (it = 0; it < max_iterations; ++it) {
         /* the exact Hessian after two full steps in a row (see integrators.h) */
@@ -157,7 +157,11 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         fscale = sqrt(fscale);
         if (g0norm < 0) g0norm = gnorm;
         double scale = fmax(g0norm, fscale);
-        if (s->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) break;
+        last_rel = scale > 0 ? gnorm / scale : 0;
+        if (s->n_free == 0 || gnorm <= w->def.newton_tolerance * scale || gnorm == 0) {
+            converged = 1;
+            break;
+        }
         st = factorize(w, s, cM, cD, err);
         if (st == SEM_ERR_NUMERIC && exact) {
             /* the exact system is not positive definite (e.g. a buckled or unstable
@@ -201,13 +205,35 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             goto done;
         }
         memcpy(q, qtry, n * sizeof(double));
+        /* stalled at round-off: the energy cannot decrease any more */
         if (dmax <= 1e-14 * (1.0 + fabs(q[0]))) {
             ++it;
+            converged = 1;
             break;
         }
     }
     w->last_iterations = it;
     w->counters.newton_iterations += it;
+    if (!converged) {
+        if (!w->def.accept_unconverged) {
+            st = sem_error_set(err, SEM_ERR_NUMERIC,
+                               "%s did not converge in %d Newton iterations at t = %g (relative gradient %.2g, "
+                               "tolerance %.2g): no equilibrium was found (a part free to move: unpinned, or "
+                               "zero-energy modes; or loads too large for the material); set "
+                               "integrator.accept_unconverged to keep such steps",
+                               dynamic ? "the implicit Euler step" : "the static solve", it, t1, last_rel,
+                               w->def.newton_tolerance);
+            goto done;
+        }
+        w->counters.unconverged_solves++;
+        if (w->def.log) {
+            char line[256];
+            snprintf(line, sizeof line,
+                     "Newton did not converge in %d iterations at t = %g (relative gradient %.2g); kept "
+                     "(accept_unconverged)", it, t1, last_rel);
+            w->def.log(w->def.log_user, 1, line);
+        }
+    }
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(q[i])) {
             st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);

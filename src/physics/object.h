@@ -105,6 +105,7 @@ typedef struct sem_object {
     double *qc;                /* q minus its mean, 3 n_ctrl (see sem_centered) */
     double elastic_energy;
     double volume, mass;
+    double runaway_budget;     /* runaway.c: energy the inputs can supply */
 } sem_object;
 
 /* Control points in group g. */

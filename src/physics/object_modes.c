@@ -17,8 +17,9 @@
  * (rho L^2) and the solves through a system of the object's matrices (system.h) with every
  * control point free: a shallow copy of the object with its own free numbering, so the
  * object's own system (pins, factorization) is untouched. A spurious mode moves some parts
- * against the rest; the parts holding more than 20% of a spurious mode's kinetic energy
- * (x^T M x summed over their control points) are the ones reported as not held.
+ * against the rest; the parts holding at least a quarter of the largest part share of a
+ * spurious mode's kinetic energy (x^T M x summed over their control points) are the ones
+ * reported as not held.
  */
 #include "world.h"
 
@@ -136,10 +137,10 @@ sem_status sem_world_object_modes(sem_world *w, int object, sem_object_modes *ou
         for (int i = 0; i < o->n_parts; ++i)
             for (int p = o->d->part_ctrl_offset[i]; p < o->d->part_ctrl_offset[i + 1]; ++p)
                 for (int d = 0; d < 3; ++d) share[i] += v[3 * (size_t)p + d] * Mv[3 * (size_t)p + d];
-        for (int i = 0; i < o->n_parts; ++i) total += fabs(share[i]);
+        for (int i = 0; i < o->n_parts; ++i) total = fmax(total, fabs(share[i]));
         if (part_flags && total > 0)
             for (int i = 0; i < o->n_parts; ++i)
-                if (fabs(share[i]) > 0.2 * total) part_flags[i] = 1;
+                if (fabs(share[i]) >= 0.25 * total) part_flags[i] = 1;
     }
 done:
     sem_system_destroy(s);

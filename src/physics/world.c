@@ -21,6 +21,8 @@
 #include <string.h>
 
 #include "assembly.h"
+#include "input_scales.h"
+#include "runaway.h"
 #include "loads.h"
 #include "system.h"
 
@@ -218,6 +220,8 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
             }
         }
     }
+    /* numbers that make a step meaningless (input_scales.c) */
+    if ((st = sem_check_input_scales(&w->def, def, d->length_scale, d->volume, err)) != SEM_OK) goto fail;
     sem_model_get_q(def->model, o->q0);
     memcpy(o->q, o->q0, nq * sizeof(double));
     o->volume = 0;
@@ -276,6 +280,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
             o->v[3 * c + 2] = v0[2] + om[0] * r[1] - om[1] * r[0];
         }
     }
+    if ((st = sem_runaway_init(o, w->def.gravity, err)) != SEM_OK) goto fail;
     if (w->n_objects == w->cap) {
         int nc = w->cap ? 2 * w->cap : 4;
         sem_object **x = realloc(w->objects, (size_t)nc * sizeof *x);

@@ -716,7 +716,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
     const cJSON *in = cJSON_GetObjectItemCaseSensitive(root, "integrator");
     if (in) {
         static const char *const keys[] = {"type", "dt", "damping", "tolerance", "max_iterations",
-                                           "solver", NULL};
+                                           "solver", "accept_unconverged", NULL};
         const char *w = "integrator";
         if ((st = check_keys(c, in, w, keys)) != SEM_OK) return st;
         const cJSON *t = cJSON_GetObjectItemCaseSensitive(in, "type");
@@ -749,6 +749,11 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
         if ((st = get_number(c, in, "tolerance", w, &s->world.newton_tolerance)) != SEM_OK) return st;
         if (!(s->world.newton_tolerance > 0)) return fail(c, "integrator.tolerance", "must be positive");
         if ((st = get_int(c, in, "max_iterations", w, &s->world.newton_max_iterations)) != SEM_OK) return st;
+        const cJSON *au = cJSON_GetObjectItemCaseSensitive(in, "accept_unconverged");
+        if (au) {
+            if (!cJSON_IsBool(au)) return fail(c, "integrator.accept_unconverged", "must be true or false");
+            s->world.accept_unconverged = cJSON_IsTrue(au);
+        }
         if (s->world.newton_max_iterations < 1) return fail(c, "integrator.max_iterations", "must be >= 1");
         const cJSON *so = cJSON_GetObjectItemCaseSensitive(in, "solver");
         if (so) {
