@@ -172,9 +172,11 @@ int sem_world_last_iterations(const sem_world *world);
 /* Zero-energy (spurious) modes of an object: motions of the free object, beyond the 6
  * rigid ones, that its rest stiffness (elastic + error energy) does not resist. values are
  * the lowest non-rigid eigenvalues of K x = lambda M x as lambda rho L^2 / E (L the
- * preprocessing length scale): elastic modes are 1e-4 and up, spurious ones below
- * SEM_SPURIOUS_MODE_TOLERANCE. spurious == n_values means at least that many. */
-#define SEM_SPURIOUS_MODE_TOLERANCE 1e-6
+ * preprocessing length scale): a body's elastic modes are above about 2 / a^2 (a its aspect
+ * ratio: 5e-3 for a 1:20 beam), spurious ones below SEM_SPURIOUS_MODE_TOLERANCE (so bodies
+ * thinner than about 1:400 would be counted too). spurious == n_values means at least that
+ * many. */
+#define SEM_SPURIOUS_MODE_TOLERANCE 1e-5
 #define SEM_MODES_MAX 8
 typedef struct sem_object_modes {
     int spurious;

@@ -166,9 +166,9 @@ class sem_model(Structure):
 
 class sem_preprocess_options(Structure):
     _c_header_ = "preprocess.h"
-    _fields_ = [("order", c_int), ("rays", c_int * 2), ("ray_axis", c_int),
+    _fields_ = [("order", c_int), ("spacing", c_double), ("rays", c_int * 2), ("ray_axis", c_int),
                 ("points_per_interval", c_int), ("alpha", c_double), ("sparsity", c_double),
-                ("weight_threshold", c_double), ("gamma", c_double),
+                ("weight_threshold", c_double), ("origin_rule", c_int), ("gamma", c_double),
                 ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int)]
 
 
@@ -191,7 +191,9 @@ class sem_discretization(Structure):
                 ("n_samples", c_int), ("sample_part", POINTER(c_int)),
                 ("sample_uv", POINTER(c_double)), ("sample_X", POINTER(c_double)),
                 ("sample_area", POINTER(c_double)), ("J_hat", sem_csr),
-                ("n_quad", c_int), ("quad_X", POINTER(c_double)),
+                ("frame_axes", c_double * 9), ("frame_center", c_double * 3),
+                ("frame_lo", c_double * 3), ("frame_hi", c_double * 3),
+                ("quad_spacing", c_double), ("n_quad", c_int), ("quad_X", POINTER(c_double)),
                 ("quad_volume", POINTER(c_double)), ("quad_part", POINTER(c_int)),
                 ("volume", c_double),
                 ("alpha", c_double), ("W", sem_csr), ("W_samples", sem_csr),

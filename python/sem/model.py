@@ -148,8 +148,9 @@ class Model:
 
     def preprocess(self, **settings):
         """SEM preprocessing (paper Sec. 5-6) with the keys of a scene's "sem" object:
-        order, rays, ray_axis, points_per_interval, alpha, sparsity, gamma, tessellation,
-        weight_threshold, plus youngs_modulus (for the default gamma) and threads."""
+        order, spacing, rays, ray_axis, points_per_interval, alpha, sparsity, gamma,
+        tessellation, weight_threshold, origins ("coupled" or "paper"), plus youngs_modulus (for
+        the default gamma) and threads."""
         options = lib.sem_default_preprocess_options()
         for key, value in settings.items():
             if key == "rays":
@@ -160,13 +161,17 @@ class Model:
                 if value not in ("x", "y", "z", 0, 1, 2):
                     raise ValueError('ray_axis: "x", "y" or "z"')
                 options.ray_axis = {"x": 0, "y": 1, "z": 2}.get(value, value)
-            elif key in ("alpha", "sparsity", "gamma") and value is None:
+            elif key == "origins":
+                if value not in ("coupled", "paper"):
+                    raise ValueError('origins: "coupled" or "paper"')
+                options.origin_rule = 0 if value == "coupled" else 1
+            elif key in ("alpha", "sparsity", "gamma", "spacing") and value is None:
                 setattr(options, key, 0.0)
             elif key in _OPTION_FIELDS:
                 setattr(options, key, value)
             else:
                 raise TypeError("preprocess: unknown setting %r (allowed: %s)"
-                                % (key, ", ".join(sorted(_OPTION_FIELDS | {"rays", "ray_axis"}))))
+                                % (key, ", ".join(sorted(_OPTION_FIELDS | {"rays", "ray_axis", "origins"}))))
         err = _lib.new_error()
         out = _lib._disc_p()
         check(lib.sem_preprocess(self._p, ctypes.byref(options), ctypes.byref(out),
@@ -180,8 +185,8 @@ class Model:
             self.parts, self.control_points, self.units[0])
 
 
-_OPTION_FIELDS = {"order", "points_per_interval", "alpha", "sparsity", "weight_threshold",
-                  "gamma", "youngs_modulus", "tessellation", "threads"}
+_OPTION_FIELDS = {"order", "spacing", "points_per_interval", "alpha", "sparsity",
+                  "weight_threshold", "gamma", "youngs_modulus", "tessellation", "threads"}
 
 
 def _view(pointer, shape, owner, dtype=np.float64):
