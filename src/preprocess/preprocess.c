@@ -37,6 +37,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/read_file.h"
+#include "sem/limits.h"
 #include "steps.h"
 
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
@@ -69,8 +71,8 @@ sem_preprocess_options sem_default_preprocess_options(void)
 }
 
 /* Upper bounds that keep a typo from asking for unbounded memory or time. */
-#define MAX_RAYS_PER_AXIS 4096
-#define MAX_POINTS_PER_INTERVAL 10000
+#define MAX_RAYS_PER_AXIS SEM_MAX_RAYS_PER_AXIS
+#define MAX_POINTS_PER_INTERVAL SEM_MAX_POINTS_PER_INTERVAL
 #define MAX_TESSELLATION 1024
 
 static sem_status validate_options(const sem_preprocess_options *o, sem_error *err)
@@ -713,47 +715,42 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
 {
     if (out) *out = NULL;
     if (!path || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_load: NULL argument");
-    FILE *f = fopen(path, "rb");
-    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat sb;
-    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_IO, "%s: not a regular file", path);
-    }
-    size_t size = (size_t)sb.st_size;
+    char *data = NULL;
+    size_t size = 0;
+    sem_status st = sem_read_file(path, SEM_MAX_CACHE_FILE_BYTES, "SEM_MAX_CACHE_FILE_BYTES", &data,
+                                  &size, err);
+    if (st != SEM_OK) return st;
+    st = sem_discretization_load_buffer(path, data, size, expected_hash, out, err);
+    free(data);
+    return st;
+}
+
+sem_status sem_discretization_load_buffer(const char *name, const void *bytes, size_t size,
+                                          unsigned long long expected_hash,
+                                          sem_discretization **out, sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!out || (!bytes && size > 0))
+        return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_load_buffer: NULL argument");
+    const char *path = name ? name : "<buffer>";
+    const unsigned char *data = bytes;
     const size_t header = sizeof sem_disc_magic + 4 + 4 + 8;
-    if (size < header + 8) {
-        fclose(f);
+    if (size < header + 8)
         return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (too short)", path);
-    }
-    unsigned char *data = malloc(size);
-    if (!data) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, size);
-    }
-    size_t got = fread(data, 1, size, f);
-    fclose(f);
-    if (got != size) {
-        free(data);
-        return sem_error_set(err, SEM_ERR_IO, "%s: read failed", path);
-    }
 
     reader r = {data, size, 0, path, err, SEM_OK};
     char magic[8];
     r_bytes(&r, magic, sizeof magic);
     if (memcmp(magic, sem_disc_magic, sizeof magic) != 0) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (bad magic)", path);
     }
     uint32_t version = r_u32(&r);
     uint32_t bom = r_u32(&r);
     if (bom != SEM_DISC_BYTE_ORDER) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: written on a machine of another byte order",
                              path);
     }
     if (version != SEM_DISC_FORMAT_VERSION) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: written by format version %u, this sem reads %u",
                              path, (unsigned)version, (unsigned)SEM_DISC_FORMAT_VERSION);
     }
@@ -764,14 +761,12 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
     uint64_t stored;
     memcpy(&stored, data + size - 8, 8);
     if (stored != sum.h) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE,
                              "%s: corrupt preprocessed data: checksum mismatch (truncated or damaged file)",
                              path);
     }
     uint64_t hash = r_u64(&r);
     if (expected_hash != 0 && hash != (uint64_t)expected_hash) {
-        free(data);
         return sem_error_set(err, SEM_ERR_INVALID,
                              "%s: preprocessed data is for a different model or settings", path);
     }
@@ -779,7 +774,6 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
 
     sem_discretization *d = calloc(1, sizeof *d);
     if (!d) {
-        free(data);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     d->model_hash = hash;
@@ -843,7 +837,6 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
                     r_fail(&r, "bad part_ctrl_offset");
         }
     }
-    free(data);
     if (r.st != SEM_OK) {
         sem_discretization_destroy(d);
         return r.st;
