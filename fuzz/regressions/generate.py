@@ -102,20 +102,29 @@ def composite_repeat(levels, repeat, name):
     save("iges", name, build(E))
 
 
-def xform_chains(n=2000, chain=31):
-    """n patches, each moved by a chain of `chain` transformation matrices (124 -> 124 ...)."""
+def xform_chains(chain=31, repeat=100, top=50):
+    """5,000 patches (the part limit), each moved by a chain of 31 transformation matrices
+    (124 -> 124 ...) inside instances that carry chains of their own."""
     E = []
     for k in range(chain):
         nxt = de(k + 1) if k + 1 < chain else 0
         E.append(Ent(124, xform([[1, 0, 0], [0, 1, 0], [0, 0, 1]], (0.001, 0, 0)), xform=nxt))
-    for j in range(n):
-        E.append(Ent(128, patch(float(j), 0, 0, 1, 1), xform=de(0)))
+    p = len(E)
+    E.append(Ent(128, patch(0, 0, 0, 1, 1), xform=de(0), status=SUB))
+    d = len(E)
+    E.append(Ent(308, ["0", holl("X"), "1", de(p)], xform=de(0), status=DEP))
+    i = len(E)
+    E.append(Ent(408, [de(d), "0.0", "0.0", "0.0", "1.0"], xform=de(0), status=SUB))
+    d2 = len(E)
+    E.append(Ent(308, ["0", holl("Y"), str(repeat)] + [de(i)] * repeat, xform=de(0), status=DEP))
+    for j in range(top):
+        E.append(Ent(408, [de(d2), str(float(j)), "0.0", "0.0", "1.0"], xform=de(0)))
     save("iges", "xform_chains.igs", build(E))
 
 
-def huge_degree(n=300, degree=31, name="huge_degree.igs"):
+def huge_degree(n=60, degree=31, name="huge_degree.igs"):
     """One degree-31 x 31 surface with as many control points and knot spans as fit in
-    about 1 MB (single-digit numbers); with n=75 the largest such surface within
+    about 1 MB (single-digit numbers); with n=40 the largest such surface within
     SEM_MAX_MODEL_SPAN_WORK."""
     knots = [0] * (degree + 1) + list(range(1, n - degree)) + [n - degree] * (degree + 1)
     grid = [[(i % 10, j % 10, (i + j) % 3) for i in range(n)] for j in range(n)]
@@ -155,11 +164,11 @@ def trim_huge_coordinates():
     save("iges", "trim_huge_coordinates.igs", build(E))
 
 
-def trim_many_spans(spans=20000):
-    """One trim curve of degree 1 with 20,000 spans zig-zagging across the whole domain."""
+def trim_many_spans(spans=9000):
+    """One trim curve of degree 1 with 9,000 spans zig-zagging across the whole domain."""
     pts = [((k + 0.5) / (spans + 1), 0.05 if k % 2 == 0 else 0.95, 0) for k in range(spans + 1)]
     knots = [0, 0] + list(range(1, spans)) + [spans, spans]
-    curve = Ent(126, nurbs_curve(1, knots, pts, fmt=lambda x: "%.6g" % x), status=SUB)
+    curve = Ent(126, nurbs_curve(1, knots, pts, fmt=lambda x: "%.4g" % x), status=SUB)
     E = trimmed_patch_with_loop([curve], 3)
     save("iges", "trim_many_spans.igs", build(E))
 
@@ -185,9 +194,9 @@ def control_bytes():
 
 # -------------------------------------------------------------------- OBJ ----
 
-def obj_trim_references(n_points=1500, refs=50000):
-    """One curv2 of 1500 points referenced 50,000 times by one trim statement: every
-    reference used to deep-copy the curve (2.5 GB from 311 KB)."""
+def obj_trim_references(n_points=2000, refs=2001):
+    """One curv2 of 2000 points referenced 2001 times by one trim statement: every
+    reference used to deep-copy the curve (2.5 GB from 311 KB with more references)."""
     out = ["v 0 0 0", "v 1 0 0", "v 0 1 0", "v 1 1 0"]
     for k in range(n_points):
         out.append("vp %g %g" % (0.5 + 0.4 * (k % 2), 0.5))
@@ -246,9 +255,8 @@ if __name__ == "__main__":
     composite_repeat(3, 200, "composite_repeat_deep.igs")
     xform_chains()
     huge_degree()
-    huge_degree(n=75, name="huge_degree_accepted.igs")
+    huge_degree(n=40, name="huge_degree_accepted.igs")
     curved_parts()
-    huge_count()
     trim_huge_coordinates()
     trim_many_spans()
     self_references()

@@ -27,11 +27,11 @@
 #define SEM_MAX_PART_CONTROL_POINTS 1000000    /* control points of one surface */
 #define SEM_MAX_MODEL_CONTROL_POINTS 4000000   /* surfaces and trim curves of one model */
 #define SEM_MAX_KNOTS 100000                   /* knots of one curve or one surface direction */
-#define SEM_MAX_MODEL_SPAN_WORK 2e8             /* evaluation work of all surfaces: the sum
+#define SEM_MAX_MODEL_SPAN_WORK 5e7             /* evaluation work of all surfaces: the sum
                                                   over knot spans of (degree_u + 1)
                                                   (degree_v + 1) G_u G_v, G = min(24,
-                                                  max(8, degree + 6)) Gauss points; 154,000
-                                                  bicubic spans, 339 of degree 31 */
+                                                  max(8, degree + 6)) Gauss points; 38,000
+                                                  bicubic spans, 84 of degree 31 */
 #define SEM_MAX_TRIM_CURVES 100000             /* curves in one part's trim loops */
 #define SEM_MAX_TRIM_SEGMENTS 8192             /* knot spans over one part's trim curves */
 
