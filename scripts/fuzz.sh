@@ -33,7 +33,7 @@ while [ $# -gt 0 ]; do
 done
 [ ${#names[@]} -gt 0 ] || names=(iges obj scene cache)
 
-build=build-fuzz
+build="${SEM_FUZZ_BUILD:-build-fuzz}"
 CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSEM_FUZZ=ON >/dev/null
 targets=()
 for n in "${names[@]}"; do targets+=("fuzz_$n"); done

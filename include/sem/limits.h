@@ -35,6 +35,13 @@
 #define SEM_MAX_TRIM_CURVES 100000             /* curves in one part's trim loops */
 #define SEM_MAX_TRIM_SEGMENTS 8192             /* knot spans over one part's trim curves */
 
+/* ---- preprocessing (estimated from the model and the settings before any step runs) ---- */
+#define SEM_MAX_PREPROCESS_CONTROL_POINTS 20000 /* the cubes study's largest has 3546 */
+#define SEM_MAX_BOUNDARY_ENTRIES 1e7           /* boundary samples x control points each
+                                                  touches ((degree + 1)^2): J-hat's size */
+#define SEM_MAX_TRIANGLES 4e6                  /* ray-casting tessellation */
+#define SEM_MAX_QUADRATURE_POINTS 1e7          /* rays[0] x rays[1] x points_per_interval */
+
 /* ---- settings ---- */
 #define SEM_MAX_RAYS_PER_AXIS 4096             /* sem.rays, --rays */
 #define SEM_MAX_POINTS_PER_INTERVAL 10000      /* sem.points_per_interval */

@@ -339,6 +339,70 @@ static int model_is_flat(const sem_model *model)
     return lmin / (double)n <= 1e-20 * diag2;
 }
 
+/* Knot spans in use along one direction. */
+static double spans_in_use(int degree, int n, const double *knots, double t0, double t1)
+{
+    double spans = 1;
+    for (int i = degree + 1; i < n; ++i)
+        spans += knots[i] > knots[i - 1] && knots[i] > t0 && knots[i] < t1;
+    return spans;
+}
+
+/* What the settings and the model would make the steps build, estimated before any of it
+ * is built (sem/limits.h): a small file can hold a surface of degree 31 whose boundary
+ * samples each touch 1024 control points (3.6 GB of J-hat for a 70 KB file), and a ray grid
+ * or tessellation can be set to billions of rays or triangles. The genuine size of a model
+ * (many parts coupled by the weights) is not limited here. */
+static sem_status check_sizes(const sem_model *model, const sem_preprocess_options *o,
+                              sem_error *err)
+{
+    double entries = 0, triangles = 0, ctrl = 0;
+    for (int i = 0; i < model->n_parts; ++i) {
+        const sem_part *part = &model->parts[i];
+        const sem_surface *s = &part->surface;
+        int trimmed = part->has_outer || part->n_holes > 0;
+        double su = spans_in_use(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1);
+        double sv = spans_in_use(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1);
+        /* sampling.c: (degree + 1) Lobatto points per span, at least 24 (+ a span's worth)
+         * per direction on a trimmed part; each sample holds (p + 1)(q + 1) basis values */
+        double pu = s->degree_u + 1 < 2 ? 2 : s->degree_u + 1;
+        double pv = s->degree_v + 1 < 2 ? 2 : s->degree_v + 1;
+        double nu = su * pu, nv = sv * pv;
+        if (trimmed) {
+            nu = fmax(nu, 24 + 2 * pu);
+            nv = fmax(nv, 24 + 2 * pv);
+        }
+        entries += nu * nv * (s->degree_u + 1) * (s->degree_v + 1);
+        triangles += 2.0 * su * sv * o->tessellation * o->tessellation;
+        ctrl += (double)s->n_u * s->n_v;
+    }
+    if (ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
+                                                   "takes at most %d (limit "
+                                                   "SEM_MAX_PREPROCESS_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+    if (entries > SEM_MAX_BOUNDARY_ENTRIES)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "boundary sampling would store %.3g basis values (samples times "
+                             "the (degree + 1)^2 control points each touches; limit "
+                             "SEM_MAX_BOUNDARY_ENTRIES = %.3g): lower the surfaces' degree or "
+                             "knot count",
+                             entries, (double)SEM_MAX_BOUNDARY_ENTRIES);
+    if (triangles > SEM_MAX_TRIANGLES)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "tessellation %d would make %.3g triangles (limit "
+                             "SEM_MAX_TRIANGLES = %.3g): lower the tessellation",
+                             o->tessellation, triangles, (double)SEM_MAX_TRIANGLES);
+    double points = (double)o->rays[0] * o->rays[1] * o->points_per_interval;
+    if (points > SEM_MAX_QUADRATURE_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "rays %d x %d with %d points per interval would make at least %.3g "
+                             "quadrature points (limit SEM_MAX_QUADRATURE_POINTS = %.3g)",
+                             o->rays[0], o->rays[1], o->points_per_interval, points,
+                             (double)SEM_MAX_QUADRATURE_POINTS);
+    return SEM_OK;
+}
+
 sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *options,
                           sem_discretization **out, sem_error *err)
 {
@@ -356,6 +420,8 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     if (model_is_flat(model))
         return sem_error_set(err, SEM_ERR_INVALID,
                              "model encloses no volume (all its surfaces lie in one plane)");
+    st = check_sizes(model, &o, err);
+    if (st != SEM_OK) return st;
 
     int saved_threads = omp_get_max_threads();
     if (o.threads > 0) omp_set_num_threads(o.threads);
