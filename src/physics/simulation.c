@@ -118,7 +118,7 @@ typedef struct object {
     double *Kz;                /* n_pairs x (3ma)^2, for pairs with points (Kz_ba = Kz_ab) */
     int nthreads;
     int exact_hessian;         /* 1: skip the PSD projection (Newton near a minimum) */
-    double *grad_z_thread;
+    double *grad_z_share;      /* GRADIENT_SHARES x n_parts*ma x 3 (see assemble_elastic) */
     double *qc;                /* q minus its mean, 3 n_ctrl (see centered) */
     double elastic_energy;
     double volume, mass;
@@ -239,7 +239,7 @@ static void object_destroy(object *o)
     free(o->grad_z);
     free(o->Kz);
     free(o->qc);
-    free(o->grad_z_thread);
+    free(o->grad_z_share);
     free((void *)o->def.point_loads);
     free((void *)o->def.region_loads);
     free(o);
@@ -965,6 +965,13 @@ static void compute_gravity(object *o, const double g[3])
     free(fp);
 }
 
+/* The per-point loop of the elastic assembly sums into this many gradient and energy
+ * accumulators, each over fixed blocks of SHARE_BLOCK points, added in order afterwards: the
+ * result is the same bits on any thread count (a per-thread accumulator would depend on
+ * it). It also caps that loop's parallelism at 16 threads. */
+#define GRADIENT_SHARES 16
+#define SHARE_BLOCK 64
+
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
                                    const double *system, sem_error *err);
 
@@ -1102,9 +1109,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = setup_constant_blocks(o, err)) != SEM_OK) goto fail;
     if ((st = setup_constant_csr(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
-    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
+    o->grad_z_share =
+        malloc(((size_t)GRADIENT_SHARES * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
-    if (!o->qc || !o->grad_z_thread) {
+    if (!o->qc || !o->grad_z_share) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -1268,60 +1276,68 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
         }
     }
     int nth = o->nthreads;
-    double energy_total = 0;
+    double energy_total = 0, share_energy[GRADIENT_SHARES] = {0};
     int bad = 0;
-    double *thread_energy = calloc((size_t)nth, sizeof(double));
-    if (!thread_energy) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    memset(o->grad_z_share, 0, (size_t)GRADIENT_SHARES * nz * sizeof(double));
 #pragma omp parallel num_threads(nth) reduction(| : bad)
     {
-        int t = omp_get_thread_num();
-        double *gz = o->grad_z_thread + (size_t)t * nz;
-        memset(gz, 0, nz * sizeof(double));
-        double energy = 0;
         for (int c0 = 0; c0 < o->n_quad; c0 += o->chunk) {
             int c1 = o->n_quad - c0 > o->chunk ? c0 + o->chunk : o->n_quad;
-            /* per point: F, psi, P, and N_p (static shares: deterministic for a fixed
-             * thread count) */
+            /* per point: F, psi, P, and N_p. Blocks of SHARE_BLOCK points go to the
+             * GRADIENT_SHARES accumulators in turn (block b to share b mod S), whatever the
+             * thread count and the chunk size; each share sums its points in point order
+             * (continued from chunk to chunk), and the shares are added in order below, so
+             * the sums are the same bits on any number of threads. */
 #pragma omp for schedule(static)
-            for (int p = c0; p < c1; ++p) {
-                int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-                const double *D = o->point_D + (size_t)p * ma * 3;
-                double zb[27] = {0}; /* sum_i w_i z_i */
-                for (int r = r0; r < r1; ++r) {
-                    const double *zi = o->z + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
-                }
-                double F[9];
-                for (int dd = 0; dd < 3; ++dd)
-                    for (int e = 0; e < 3; ++e) {
-                        double f = 0;
-                        for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
-                        F[dd * 3 + e] = f;
+            for (int sh = 0; sh < GRADIENT_SHARES; ++sh) {
+                double *gz = o->grad_z_share + (size_t)sh * nz;
+                double energy = share_energy[sh];
+                for (int p = c0; p < c1; ++p) {
+                    if ((p / SHARE_BLOCK) % GRADIENT_SHARES != sh) {
+                        /* skip to this share's next block */
+                        p += SHARE_BLOCK - 1 - p % SHARE_BLOCK;
+                        continue;
                     }
-                double P[9], H[81];
-                double vol = d->quad_volume[p];
-                double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
-                if (!isfinite(psi)) {
-                    bad = 1;
-                    if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
-                    continue;
-                }
-                energy += vol * psi;
-                /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
-                double v[27];
-                for (int k = 0; k < ma; ++k)
+                    int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+                    const double *D = o->point_D + (size_t)p * ma * 3;
+                    double zb[27] = {0}; /* sum_i w_i z_i */
+                    for (int r = r0; r < r1; ++r) {
+                        const double *zi = o->z + (size_t)W->col[r] * ma * 3;
+                        double w = W->val[r];
+                        for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
+                    }
+                    double F[9];
                     for (int dd = 0; dd < 3; ++dd)
-                        v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
-                                               P[dd * 3 + 2] * D[k * 3 + 2]);
-                for (int r = r0; r < r1; ++r) {
-                    double *gzi = gz + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
+                        for (int e = 0; e < 3; ++e) {
+                            double f = 0;
+                            for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
+                            F[dd * 3 + e] = f;
+                        }
+                    double P[9], H[81];
+                    double vol = d->quad_volume[p];
+                    double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
+                    if (!isfinite(psi)) {
+                        bad = 1;
+                        if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
+                        continue;
+                    }
+                    energy += vol * psi;
+                    /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
+                    double v[27];
+                    for (int k = 0; k < ma; ++k)
+                        for (int dd = 0; dd < 3; ++dd)
+                            v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
+                                                   P[dd * 3 + 2] * D[k * 3 + 2]);
+                    for (int r = r0; r < r1; ++r) {
+                        double *gzi = gz + (size_t)W->col[r] * ma * 3;
+                        double w = W->val[r];
+                        for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
+                    }
+                    if (!want_hessian) continue;
+                    if (!o->exact_hessian) sem_project_psd_9x9(H);
+                    point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
                 }
-                if (!want_hessian) continue;
-                if (!o->exact_hessian) sem_project_psd_9x9(H);
-                point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
+                share_energy[sh] = energy;
             }
             if (!want_hessian) continue;
             /* per upper part pair: Kz_ab += sum_p w_a w_b N_p over the chunk's points, each
@@ -1357,19 +1373,17 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                 }
             }
         }
-        thread_energy[t] = energy;
     }
-    for (int t = 0; t < nth; ++t) energy_total += thread_energy[t];
-    free(thread_energy);
+    for (int sh = 0; sh < GRADIENT_SHARES; ++sh) energy_total += share_energy[sh];
     if (bad)
         return sem_error_set(err, SEM_ERR_NUMERIC,
                              "an element inverted or the state became non-finite (elastic energy "
                              "undefined)");
     o->elastic_energy = energy_total;
-    /* reduce in thread order */
-    memcpy(o->grad_z, o->grad_z_thread, nz * sizeof(double));
-    for (int t = 1; t < nth; ++t)
-        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_thread[(size_t)t * nz + k];
+    /* reduce in share order */
+    memcpy(o->grad_z, o->grad_z_share, nz * sizeof(double));
+    for (int sh = 1; sh < GRADIENT_SHARES; ++sh)
+        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_share[(size_t)sh * nz + k];
     if (grad_q) {
         memset(grad_q, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
         for (int i = 0; i < o->n_parts; ++i) {
@@ -1894,6 +1908,7 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
 /* queries                                                                             */
 
 double sem_world_time(const sem_world *w) { return w->time; }
+void sem_world_set_time(sem_world *w, double time) { w->time = time; }
 int sem_world_object_count(const sem_world *w) { return w->n_objects; }
 int sem_world_object_dofs(const sem_world *w, int i) { return 3 * w->objects[i]->n_ctrl; }
 const double *sem_world_object_q(const sem_world *w, int i) { return w->objects[i]->q; }
