@@ -34,6 +34,7 @@ done
 [ ${#names[@]} -gt 0 ] || names=(iges obj scene cache)
 
 build="${SEM_FUZZ_BUILD:-build-fuzz}"
+bash scripts/setup.sh --fuzz
 CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSEM_FUZZ=ON >/dev/null
 targets=()
 for n in "${names[@]}"; do targets+=("fuzz_$n"); done

@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sem needs when they are missing (run as root, or with sudo).
 set -euo pipefail
-# clang, libclang-rt-dev (libFuzzer) and libomp-dev (OpenMP for clang): scripts/fuzz.sh
+#   bash scripts/setup.sh          what building and running sem needs
+#   bash scripts/setup.sh --fuzz   also clang, libclang-rt-dev (libFuzzer) and libomp-dev
+#                                  (OpenMP for clang), for scripts/fuzz.sh
 packages=(build-essential cmake pkg-config libembree-dev libsuitesparse-dev libopenblas-dev
-          liblapacke-dev libglpk-dev libcjson-dev clang libclang-rt-dev libomp-dev)
+          liblapacke-dev libglpk-dev libcjson-dev)
+if [ "${1:-}" = "--fuzz" ]; then
+  packages+=(clang libclang-rt-dev libomp-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -10,8 +10,9 @@
  *     SEM_MAX_MODEL_CONTROL_POINTS)
  *
  * The limits are far above every real model we know (the largest of the paper's models
- * has 3546 control points and 6500 IGES entities; the biggest file is 422 KB) and low
- * enough that no input of 1 MB or less makes `sem inspect` use more than 1 GB of memory.
+ * has 3558 control points and 394 parts; the biggest file is 422 KB) and low enough that
+ * no input of 1 MB or less makes `sem inspect` use more than 1 GB or 10 s (tests/
+ * test_limits.c, docs/reliability.md).
  * Only regular files are read: devices, FIFOs and folders are refused before any read.
  */
 #ifndef SEM_LIMITS_H
