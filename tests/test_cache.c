@@ -8,7 +8,9 @@
  *    refreshes an entry), an entry larger than the whole bound is not stored;
  *  - a damaged entry (one flipped byte) and a forged one (right checksum and hash, sizes of
  *    another model) are misses with a reason, never a crash;
- *  - `sem preprocess` fills the entry that `sem run` then reads (preprocess_cached).
+ *  - `sem preprocess` fills the entry that `sem run` then reads (preprocess_cached);
+ *  - corrupted files with a valid checksum (every size field near INT32_MAX, NaN values,
+ *    flipped bytes all over the file) fail with one line, or load a consistent object.
  */
 #include <cjson/cJSON.h>
 #include <dirent.h>
@@ -184,8 +186,84 @@ static void test_commands(const char *tmp)
     CHECK(rc == 0 && entries == 0, "--no-cache: exit %d, %d entries", rc, entries);
 }
 
+static unsigned long long fnv(const unsigned char *p, size_t n)
+{
+    unsigned long long h = 14695981039346656037ull;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* Loads a variant of `good` (the checksum recomputed, as a forger would) and checks that it
+ * fails with a message or loads; the sanitized build checks the memory accesses. */
+static void load_variant(unsigned char *data, size_t size, const char *what)
+{
+    unsigned long long h = fnv(data, size - 8);
+    memcpy(data + size - 8, &h, 8);
+    sem_discretization *d = NULL;
+    sem_error err;
+    sem_error_clear(&err);
+    sem_status st = sem_discretization_load_buffer(what, data, size, 0, &d, &err);
+    CHECK(st == SEM_OK ? d != NULL : (d == NULL && err.message[0] != '\0'), "%s: status %d, '%s'",
+          what, (int)st, err.message);
+    if (st == SEM_OK) CHECK(d->n_ctrl >= 0 && d->n_quad >= 0, "%s: sizes", what);
+    sem_discretization_destroy(d);
+}
+
+static void test_corrupted(void)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/../../fuzz/corpus/cache/sphere_order2.semdisc", SEM_TEST_DATA);
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL, "%s", path);
+    if (!f) return;
+    fseek(f, 0, SEEK_END);
+    size_t size = (size_t)ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *good = malloc(size), *v = malloc(size);
+    size_t got = good ? fread(good, 1, size, f) : 0;
+    fclose(f);
+    if (!good || !v || got != size) {
+        CHECK(0, "read %s", path);
+        free(good);
+        free(v);
+        return;
+    }
+    /* the 7 int32 sizes after magic, version, byte order and hash */
+    static const int32_t huge[] = {0x7fffffff, -1, 0x40000000, 3};
+    for (int k = 0; k < 7; ++k)
+        for (size_t h = 0; h < sizeof huge / sizeof huge[0]; ++h) {
+            memcpy(v, good, size);
+            memcpy(v + 24 + 4 * k, &huge[h], 4);
+            char what[64];
+            snprintf(what, sizeof what, "size field %d = %d", k, huge[h]);
+            load_variant(v, size, what);
+        }
+    /* every 8-byte word in turn set to NaN, then to an all-ones count (sampled every 97
+     * words: every array of the file gets hits) */
+    static const unsigned char nan[8] = {0, 0, 0, 0, 0, 0, 0xf8, 0x7f};
+    for (size_t at = 24; at + 16 <= size; at += 8 * 97) {
+        memcpy(v, good, size);
+        memcpy(v + at, nan, 8);
+        load_variant(v, size, "NaN word");
+        memcpy(v, good, size);
+        memset(v + at, 0xff, 8);
+        load_variant(v, size, "all-ones word");
+    }
+    /* truncated at many lengths */
+    for (size_t n = 16; n < size; n += size / 53 + 1) {
+        memcpy(v, good, n);
+        load_variant(v, n, "truncated");
+    }
+    free(good);
+    free(v);
+}
+
 int main(void)
 {
+    test_corrupted();
     const char *tmp = test_tmpdir();
     test_library(tmp);
     test_commands(tmp);

@@ -247,6 +247,33 @@ def scenes():
     save("scene", "control_bytes.json", '{%s, "fr\\u001b[2Jmes": 1}\n' % base)
 
 
+# ---------------------------------------------------------------- caches ----
+
+def fnv_fix(data):
+    """Writes the FNV-1a 64 checksum of everything before the last 8 bytes into them."""
+    h = 14695981039346656037
+    for b in data[:-8]:
+        h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return data[:-8] + h.to_bytes(8, "little")
+
+
+def save_bytes(folder, name, data):
+    path = os.path.join(HERE, folder, name)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "wb") as f:
+        f.write(data)
+    print("%-40s %8d bytes" % (folder + "/" + name, len(data)))
+
+
+def caches():
+    """Damaged preprocessed files, from the seed corpus's sphere, with a valid checksum."""
+    with open(os.path.join(HERE, "..", "corpus", "cache", "sphere_order2.semdisc"), "rb") as f:
+        good = f.read()
+    save_bytes("cache", "truncated.semdisc", fnv_fix(good[:1000]))
+    save_bytes("cache", "header_only.semdisc", fnv_fix(good[:60]))
+    # (sizes near INT32_MAX, NaN values and flipped bytes of the whole file are made at run
+    # time by tests/test_cache.c, to keep these 110 KB variants out of the repository)
+
 if __name__ == "__main__":
     subfigure_fanout()
     subfigure_repeat()
@@ -265,3 +292,4 @@ if __name__ == "__main__":
     obj_open_trim()
     obj_huge_coordinates()
     scenes()
+    caches()
