@@ -966,11 +966,12 @@ static void compute_gravity(object *o, const double g[3])
 }
 
 /* The per-point loop of the elastic assembly sums into this many gradient and energy
- * accumulators, each over fixed blocks of SHARE_BLOCK points, added in order afterwards: the
- * result is the same bits on any thread count (a per-thread accumulator would depend on
- * it). It also caps that loop's parallelism at 16 threads. */
+ * accumulators, each over fixed blocks of points, added in order afterwards: the result is
+ * the same bits on any thread count (a per-thread accumulator would depend on it). Blocks
+ * are n_quad / (4 x GRADIENT_SHARES) points (rounded up), so every share gets 4 blocks (+-1)
+ * and the shares, spread statically over the threads, have equal work. It caps that loop's
+ * parallelism at 16 threads. */
 #define GRADIENT_SHARES 16
-#define SHARE_BLOCK 64
 
 static sem_status assemble_elastic(object *o, const double *q, int want_hessian, double *grad_q,
                                    const double *system, sem_error *err);
@@ -1278,12 +1279,15 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
     int nth = o->nthreads;
     double energy_total = 0, share_energy[GRADIENT_SHARES] = {0};
     int bad = 0;
+    const int block = (o->n_quad + 4 * GRADIENT_SHARES - 1) / (4 * GRADIENT_SHARES) > 0
+                          ? (o->n_quad + 4 * GRADIENT_SHARES - 1) / (4 * GRADIENT_SHARES)
+                          : 1;
     memset(o->grad_z_share, 0, (size_t)GRADIENT_SHARES * nz * sizeof(double));
 #pragma omp parallel num_threads(nth) reduction(| : bad)
     {
         for (int c0 = 0; c0 < o->n_quad; c0 += o->chunk) {
             int c1 = o->n_quad - c0 > o->chunk ? c0 + o->chunk : o->n_quad;
-            /* per point: F, psi, P, and N_p. Blocks of SHARE_BLOCK points go to the
+            /* per point: F, psi, P, and N_p. Blocks of `block` points go to the
              * GRADIENT_SHARES accumulators in turn (block b to share b mod S), whatever the
              * thread count and the chunk size; each share sums its points in point order
              * (continued from chunk to chunk), and the shares are added in order below, so
@@ -1293,9 +1297,9 @@ static sem_status assemble_elastic(object *o, const double *q, int want_hessian,
                 double *gz = o->grad_z_share + (size_t)sh * nz;
                 double energy = share_energy[sh];
                 for (int p = c0; p < c1; ++p) {
-                    if ((p / SHARE_BLOCK) % GRADIENT_SHARES != sh) {
-                        /* skip to this share's next block */
-                        p += SHARE_BLOCK - 1 - p % SHARE_BLOCK;
+                    if ((p / block) % GRADIENT_SHARES != sh) {
+                        /* skip to the next block */
+                        p += block - 1 - p % block;
                         continue;
                     }
                     int r0 = W->row_start[p], r1 = W->row_start[p + 1];
