@@ -15,10 +15,21 @@
 
 #include "sem/status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Reads the regular file `path` into a malloc'ed buffer (NUL-terminated, *len bytes
  * before the NUL). Fails with one line naming the path: cannot open, not a regular file,
  * larger than max_bytes ("... (limit LIMIT_NAME)"), read error. */
 sem_status sem_read_file(const char *path, long long max_bytes, const char *limit_name,
                          char **data, size_t *len, sem_error *err);
+/* The same checks without reading, for a reader that opens the file itself (STEP through
+ * Open CASCADE): cannot open, not a regular file, larger than max_bytes. */
+sem_status sem_check_regular_file(const char *path, long long max_bytes, const char *limit_name,
+                                  sem_error *err);
 
+#ifdef __cplusplus
+}
+#endif
 #endif
