@@ -19,7 +19,8 @@
  * summary are written with the frames done, and the exit status is 1.
  *
  * A folder that holds another run's files is refused unless --overwrite is given, which
- * first removes exactly those files (frames, animation, summary, state).
+ * first removes exactly those files (frames, animation, preprocess_K.semdisc, summary,
+ * state).
  */
 #include <errno.h>
 #include <math.h>
