@@ -5,6 +5,11 @@
 # browser test of sem view).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+#   bash scripts/setup.sh                 what building and running sem needs
+#   bash scripts/setup.sh --test          also what the test suite needs (above)
+#   bash scripts/setup.sh --fuzz          also clang, libclang-rt-dev (libFuzzer) and libomp-dev
+#                                         (OpenMP for clang), for scripts/fuzz.sh
+# (both options may be given)
 # libpng, libjs-three, ffmpeg: sem render (PNG, --mp4) and sem view (three.js);
 # libocct-*: STEP files and the Open CASCADE cross-checks of our IGES (optional for a build:
 # SEM_WITH_OCCT=OFF); python3-*: the Python package's tests and example
@@ -15,7 +20,13 @@ packages=(build-essential cmake pkg-config libembree-dev libsuitesparse-dev libo
           libocct-data-exchange-dev
           python3 python3-numpy python3-pytest python3-matplotlib)
 with_tests=0
-[ "${1:-}" = "--test" ] && with_tests=1
+for arg in "$@"; do
+  case "$arg" in
+    --test) with_tests=1 ;;
+    --fuzz) packages+=(clang libclang-rt-dev libomp-dev) ;;
+    *) echo "setup.sh: unknown argument '$arg' (--test, --fuzz)" >&2; exit 2 ;;
+  esac
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

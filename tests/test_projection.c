@@ -574,7 +574,7 @@ static void test_shared_models(void)
         {"castle/castle.iges", 0, 0},
         {"cylinder.iges", 0, 0},
         {"rounded_cube.iges", 0, 0},
-        {"rocket_with_nose.iges", 0, 0},
+        {"rocket/rocket_with_nose.iges", 0, 0},
     };
     if (!test_shared_model("README.md")) {
         printf("shared models absent: skipped\n");

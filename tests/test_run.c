@@ -271,7 +271,8 @@ static void test_cache(const char *tmp)
         if (strstr(e->d_name, ".semdisc")) n++;
     if (d) closedir(d);
     CHECK(n >= 1, "%d cache files in %s", n, cache);
-    snprintf(args, sizeof args, "run --frames 0 --out %s/cache_run --quiet --no-cache", tmp);
+    snprintf(args, sizeof args, "run --frames 0 --out %s/cache_run --quiet --no-cache --overwrite",
+             tmp);
     rc = test_run_cli(args, g_out, sizeof g_out, g_err, sizeof g_err);
     CHECK(rc == 0, "--no-cache exit %d: %s", rc, g_err);
     s = read_summary(dir);

@@ -488,8 +488,39 @@ static void test_default_scene(void)
     }
 }
 
+/* Strictness beyond the keys: JSON that cJSON accepts but that would run something else than
+ * written (a repeated key reads only its first value; text after the object is ignored),
+ * integers out of range named as such, limits shared with the preprocessing code. */
+static void test_strict_json(void)
+{
+    expect_error(BOX, "\"frames\": 10, \"frames\": 1000", "scene: key \"frames\" appears more than once",
+                 NULL);
+    expect_error(BOX ", \"material\": {\"density\": 1, \"density\": 2}", "",
+                 "scene.objects[0].material: key \"density\" appears more than once", NULL);
+    expect_error(BOX, "\"frames\": 1e12", "frames", "too large");
+    expect_error(BOX, "\"frames\": 200000000", "frames", "too large (at most 100000000)");
+    expect_error(BOX, "\"frames\": 2.5", "frames", "must be an integer");
+    expect_error(BOX ", \"sem\": {\"rays\": [5000, 5]}", "", "objects[0].sem.rays", "1..4096");
+    expect_error(BOX ", \"sem\": {\"points_per_interval\": 20000}", "",
+                 "objects[0].sem.points_per_interval", "1..10000");
+    sem_error err;
+    sem_scene *s = parse("{\"objects\": [{" BOX "}]}\n{\"frames\": 3}\n", &err);
+    CHECK(!s && strstr(err.message, "t.json:2: not valid JSON: text after the end"), "%s",
+          err.message);
+    sem_scene_destroy(s);
+    /* trailing white space is fine */
+    s = parse("{\"objects\": [{" BOX "}]}\n\n  \t\n", &err);
+    CHECK(s != NULL, "trailing white space: %s", err.message);
+    sem_scene_destroy(s);
+    /* a key with control bytes is named without them */
+    s = parse("{\"objects\": [{" BOX "}], \"fr\\u001b[2Jmes\": 1}", &err);
+    CHECK(!s && strstr(err.message, "unknown key \"fr?[2Jmes\""), "%s", err.message);
+    sem_scene_destroy(s);
+}
+
 int main(void)
 {
+    test_strict_json();
     test_errors();
     test_defaults_and_values();
     test_transform();

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "sem/sem.h"
@@ -188,6 +189,17 @@ static void test_errors(void)
     }
     CHECK(sem_model_load(bad, &m, &e) == SEM_ERR_PARSE && m == NULL, "garbage: %s", e.message);
     CHECK(strstr(e.message, "garbage.stp") != NULL, "message: %s", e.message);
+    /* only regular files go to Open CASCADE (a FIFO would block it; docs/reliability.md) */
+    snprintf(path, sizeof path, "%s/fifo.step", test_tmpdir());
+    CHECK(mkfifo(path, 0600) == 0, "mkfifo %s", path);
+    CHECK(sem_model_load(path, &m, &e) == SEM_ERR_IO && m == NULL &&
+              strstr(e.message, "not a regular file (a FIFO)"),
+          "FIFO: %s", e.message);
+    snprintf(path, sizeof path, "%s/folder.stp", test_tmpdir());
+    CHECK(mkdir(path, 0700) == 0, "mkdir %s", path);
+    CHECK(sem_model_load(path, &m, &e) == SEM_ERR_IO && m == NULL &&
+              strstr(e.message, "not a regular file (a folder)"),
+          "folder: %s", e.message);
     /* a failed write leaves nothing: into a folder that does not exist */
     sem_model *box = sem_model_create();
     sem_box_def def = sem_default_box_def();

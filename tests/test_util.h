@@ -36,9 +36,12 @@ extern int test_checks;
               #a, ra_, #b, rb_, fabs(ra_ - rb_) / rs_, rt_);                              \
     } while (0)
 
-/* Prints "N passed, N failed" and returns the process exit status. */
+/* Prints "N passed, N failed" and returns the process exit status: 1 on a failure, else
+ * TEST_SKIPPED when a shared model was missing (CTest shows the test as skipped), else 0. */
+#define TEST_SKIPPED 77
 int test_finish(const char *name);
-/* Path of a shared model (../shared/models/...) or NULL when that folder is absent. */
+/* Path of a shared model (../shared/models/..., or $SEM_SHARED_MODELS/...), or NULL when it
+ * is absent; a NULL answer marks the test as skipped (test_finish). */
 const char *test_shared_model(const char *relative);
 /* A fresh temporary directory for this test (removed by the OS / CI clean clone). */
 const char *test_tmpdir(void);

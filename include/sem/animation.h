@@ -31,6 +31,7 @@ typedef struct sem_animation_def {
      * USD file is in metres (metersPerUnit 1). */
     const char *frame_units;
     double frame_unit_to_meter;
+    int frame_digits;        /* width of NNNN in frame_NNNN.*; 0: 4 */
 } sem_animation_def;
 
 typedef struct sem_animation sem_animation;
@@ -42,6 +43,10 @@ sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
 /* Writes frame `frame` with the objects' current control points q (3 per control point). */
 sem_status sem_animation_add_frame(sem_animation *anim, int frame, const double *const *q,
                                    sem_error *err);
+/* Records frame `frame` for the USD file without writing its files (they exist: a run that
+ * continues after an interruption). */
+sem_status sem_animation_restore_frame(sem_animation *anim, int frame, const double *const *q,
+                                       sem_error *err);
 /* Writes the USD file with every frame added so far. */
 sem_status sem_animation_finish(sem_animation *anim, sem_error *err);
 void sem_animation_destroy(sem_animation *anim);

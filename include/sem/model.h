@@ -79,6 +79,9 @@ sem_status sem_model_add_part(sem_model *model, const sem_part *part, sem_error 
 /* Takes ownership of the arrays inside part (part is zeroed on return). */
 sem_status sem_model_take_part(sem_model *model, sem_part *part, sem_error *err);
 sem_model *sem_model_clone(const sem_model *model);
+/* Adds a warning (control bytes shown as '?'); after SEM_MODEL_MAX_WARNINGS one last line
+ * says that the rest were dropped. */
+#define SEM_MODEL_MAX_WARNINGS 1000
 void sem_model_warn(sem_model *model, const char *fmt, ...);
 
 void sem_part_free(sem_part *part);
@@ -96,6 +99,11 @@ sem_status sem_curve_alloc(sem_curve *c, int degree, int n_ctrl);
 sem_status sem_surface_validate(const sem_surface *s, sem_error *err);
 sem_status sem_curve_validate(const sem_curve *c, sem_error *err);
 
+/* Checks what the readers check after conversion (sem/limits.h): parts, and the knot spans
+ * of all surfaces weighted by their basis size, which bounds the work of every later step
+ * (area, sampling, tessellation) for a model read from a small file. */
+sem_status sem_model_check_limits(const sem_model *model, sem_error *err);
+
 /* ---- sizes ---- */
 size_t sem_model_control_points(const sem_model *model);
 /* Offset (in control points) of each part's first control point in q; out has n_parts+1. */
@@ -107,7 +115,8 @@ void sem_model_set_q(sem_model *model, const double *q);
 /* ---- files ---- */
 /* Format by extension (any case): .igs/.iges (IGES 5.3), .obj (free-form), .step/.stp
  * (ISO 10303-21 through Open CASCADE; SEM_ERR_UNSUPPORTED when libsem was built without it,
- * see sem_has_step() in sem/version.h). */
+ * see sem_has_step() in sem/version.h). Only regular files are read, and the readers stop
+ * at the limits of sem/limits.h with a message naming the limit. */
 sem_status sem_model_load(const char *path, sem_model **out, sem_error *err);
 sem_status sem_model_save(const sem_model *model, const char *path, sem_error *err);
 sem_status sem_iges_read(const char *path, sem_model **out, sem_error *err);
@@ -115,6 +124,8 @@ sem_status sem_iges_read_buffer(const char *name, const char *data, size_t len, 
                                 sem_error *err);
 sem_status sem_iges_write(const sem_model *model, const char *path, sem_error *err);
 sem_status sem_obj_read(const char *path, sem_model **out, sem_error *err);
+sem_status sem_obj_read_buffer(const char *name, const char *data, size_t len, sem_model **out,
+                               sem_error *err);
 sem_status sem_obj_write(const sem_model *model, const char *path, sem_error *err);
 /* STEP AP214 through Open CASCADE: every face of the file becomes one part (its surface as
  * a NURBS, its wires as parameter-space trim loops; model-space edges without a

@@ -139,6 +139,10 @@ void sem_discretization_destroy(sem_discretization *d);
 sem_status sem_discretization_save(const sem_discretization *d, const char *path, sem_error *err);
 sem_status sem_discretization_load(const char *path, unsigned long long expected_hash,
                                    sem_discretization **out, sem_error *err);
+/* The same from bytes in memory (inspection tools, fuzzing); name is used in messages. */
+sem_status sem_discretization_load_buffer(const char *name, const void *data, size_t size,
+                                          unsigned long long expected_hash,
+                                          sem_discretization **out, sem_error *err);
 /* Hash of a model's geometry (degrees, knots, weights, control points, trims) and options. */
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o);
 

@@ -127,6 +127,7 @@ typedef struct sem_scene_world_options {
     const char *cache_dir;  /* folder of cached discretizations; NULL or "": no cache */
     int read_cache;         /* reuse a cached discretization when one matches */
     int write_cache;        /* store new discretizations in cache_dir */
+    long long cache_max_bytes; /* bound of the cache folder (sem/cache.h); <= 0: none */
     sem_scene_log_fn log;   /* may be NULL */
     void *log_user;
     int skip_modes;         /* 1: do not look for zero-energy modes (sem_world_object_modes;

@@ -5,6 +5,7 @@
  * models directly. The pipeline, one header per stage:
  *
  *   status.h      one error channel: sem_status codes and a sem_error message
+ *   limits.h      how much any reader reads and builds (SEM_MAX_*)
  *   version.h     SEM_VERSION_* macros, sem_version(), sem_has_step()
  *   model.h       NURBS models (parts, trims) and files (IGES, OBJ free-form, STEP)
  *   nurbs.h       B-spline / NURBS evaluation          trim.h      trimmed domains
@@ -12,6 +13,7 @@
  *   primitives.h  exact NURBS solids built in code
  *   sparse.h      compressed sparse rows (the preprocessing data)
  *   preprocess.h  model -> SEM discretization (paper Sec. 5-7, Alg. 1)
+ *   cache.h       a bounded folder of discretizations keyed by model and settings
  *   material.h    hyperelastic energy densities
  *   simulation.h  worlds, objects, integrators (Sec. 7, Alg. 2)
  *   scene.h       scene files (JSON) and the world a scene describes
@@ -25,6 +27,7 @@
 #define SEM_SEM_H
 
 #include "sem/status.h"
+#include "sem/limits.h"
 #include "sem/version.h"
 #include "sem/model.h"
 #include "sem/nurbs.h"
@@ -34,6 +37,7 @@
 #include "sem/primitives.h"
 #include "sem/sparse.h"
 #include "sem/preprocess.h"
+#include "sem/cache.h"
 #include "sem/material.h"
 #include "sem/simulation.h"
 #include "sem/scene.h"

@@ -28,7 +28,7 @@ typedef enum sem_integrator {
 } sem_integrator;
 
 typedef enum sem_solver_choice {
-    SEM_SOLVER_AUTO,   /* measure both once and keep the faster */
+    SEM_SOLVER_AUTO,   /* a fixed rule: dense up to 500 dofs, CHOLMOD above (reproducible) */
     SEM_SOLVER_SPARSE, /* CHOLMOD */
     SEM_SOLVER_DENSE   /* LAPACK dpotrf */
 } sem_solver_choice;
@@ -144,6 +144,8 @@ sem_status sem_world_step(sem_world *world, sem_error *err);
 sem_status sem_world_solve_static(sem_world *world, sem_error *err);
 
 double sem_world_time(const sem_world *world);
+/* Sets the time (with sem_world_object_set_state: continuing a stopped run exactly). */
+void sem_world_set_time(sem_world *world, double time);
 int sem_world_object_count(const sem_world *world);
 int sem_world_object_dofs(const sem_world *world, int object);
 const double *sem_world_object_q(const sem_world *world, int object);

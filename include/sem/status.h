@@ -34,6 +34,9 @@ sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...
 #endif
     ;
 void sem_error_clear(sem_error *err);
+/* Replaces control bytes (below 0x20, and 0x7f) by '?' in place; every message and model
+ * warning goes through it, so text quoted from a file cannot break a line or a terminal. */
+void sem_text_sanitize(char *text);
 const char *sem_status_name(sem_status status);
 
 #ifdef __cplusplus

@@ -16,7 +16,7 @@ import ctypes.util
 import glob
 import os
 from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int,
-                    c_size_t, c_ulonglong, c_void_p)
+                    c_longlong, c_size_t, c_ulonglong, c_void_p)
 
 
 class SemError(RuntimeError):
@@ -223,7 +223,8 @@ sem_scene_log_fn = CFUNCTYPE(None, c_void_p, c_int, c_char_p)
 class sem_scene_world_options(Structure):
     _c_header_ = "scene.h"
     _fields_ = [("cache_dir", c_char_p), ("read_cache", c_int), ("write_cache", c_int),
-                ("log", sem_scene_log_fn), ("log_user", c_void_p), ("skip_modes", c_int)]
+                ("cache_max_bytes", c_longlong), ("log", sem_scene_log_fn),
+                ("log_user", c_void_p), ("skip_modes", c_int)]
 
 
 MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,

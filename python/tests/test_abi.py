@@ -79,6 +79,8 @@ def py_fields(cls):
             kind = "char"
         elif t is ctypes.c_ulonglong:
             kind = "unsigned long long"
+        elif t is ctypes.c_longlong:
+            kind = "long long"
         elif t in (ctypes.c_void_p, ctypes.c_char_p) or issubclass(
                 t, (ctypes._Pointer, ctypes._CFuncPtr)):
             kind = "pointer"

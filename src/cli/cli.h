@@ -62,6 +62,12 @@ void cli_print_model_warnings(const sem_model *model);
  * CLI_FAILED when json is NULL or printing runs out of memory. */
 int cli_print_json(cJSON *json);
 
+/* ---- the preprocessing cache (main.c), shared by run and preprocess ---- */
+/* Folder: $SEM_CACHE_DIR, else $XDG_CACHE_HOME/sem, else $HOME/.cache/sem. */
+void cli_cache_dir(char *out, size_t size);
+/* Bound: $SEM_CACHE_MAX_MB megabytes (0: none), else SEM_CACHE_DEFAULT_MAX_BYTES. */
+long long cli_cache_max_bytes(void);
+
 /* ---- argument parsing (main.c) ---- */
 /* Parses a finite number / an integer for `option` of `command`; on bad text prints a usage
  * error and returns CLI_USAGE, else CLI_OK. */

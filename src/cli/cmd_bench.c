@@ -1,5 +1,5 @@
 /*
- * cmd_bench.c - `sem bench [--json] [--models DIR] [--steps N] [--only TEXT]`: the paper's
+ * cmd_bench.c - `sem bench [--json] [--models DIR] [--steps N] [--solver S] [--only TEXT]`: the paper's
  * Table 1 on the shared models, beside the paper's figures (MATLAB + C++ MEX on a 2.3 GHz
  * i5 laptop) with the speed-up paper / ours per column.
  *
@@ -41,6 +41,7 @@ typedef struct bench_result {
 } bench_result;
 
 static sem_status run_row(const sem_table1_row *r, const char *path, int steps, int repeat,
+                          sem_solver_choice solver,
                           bench_result *out, sem_error *err)
 {
     sem_model *m = NULL;
@@ -63,6 +64,7 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     wd.gravity[2] = -9.8;
     wd.dt = 0.01;
     wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    wd.solver = solver;
     w = sem_world_create(&wd, err);
     if (!w) {
         st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
@@ -124,6 +126,7 @@ static void print_cell(double ours, double paper)
 int cmd_bench(int argc, char **argv)
 {
     int json = 0, steps = 20, repeat = 5;
+    sem_solver_choice solver = SEM_SOLVER_AUTO;
     const char *dir = NULL, *only = NULL;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0) json = 1;
@@ -143,6 +146,13 @@ int cmd_bench(int argc, char **argv)
             int rc = cli_parse_int(CMD, "--repeat", argv[++i], &repeat);
             if (rc) return rc;
             if (repeat < 1 || repeat > 1000) return cli_fail("--repeat must be in [1, 1000] (got %d)", repeat);
+        } else if (strcmp(argv[i], "--solver") == 0) {
+            if (cli_need_values(CMD, argc, argv, i, 1)) return CLI_USAGE;
+            const char *v = argv[++i];
+            if (strcmp(v, "auto") == 0) solver = SEM_SOLVER_AUTO;
+            else if (strcmp(v, "sparse") == 0) solver = SEM_SOLVER_SPARSE;
+            else if (strcmp(v, "dense") == 0) solver = SEM_SOLVER_DENSE;
+            else return cli_usage(CMD, "--solver must be auto, sparse or dense (got '%s')", v);
         } else if (argv[i][0] == '-') return cli_usage(CMD, "unknown option '%s'", argv[i]);
         else return cli_usage(CMD, "unexpected argument '%s'", argv[i]);
     }
@@ -198,7 +208,7 @@ int cmd_bench(int argc, char **argv)
         sem_error err;
         sem_error_clear(&err);
         double t0 = omp_get_wtime();
-        if (run_row(r, path, steps, repeat, &b, &err) != SEM_OK) {
+        if (run_row(r, path, steps, repeat, solver, &b, &err) != SEM_OK) {
             cli_warn("%s: %s", r->example, err.message);
             failed++;
             continue;

@@ -1,8 +1,9 @@
 /*
  * cmd_preprocess.c - `sem preprocess FILE [options]`: run the SEM preprocessing (paper
  * Alg. 1: sampling, quadrature, weights, origins, projection, operators) on a model and
- * report its sizes and per-phase timings (the columns of Table 1); optionally save the
- * result for `sem simulate` to load.
+ * report its sizes and per-phase timings (the columns of Table 1); store the result in the
+ * preprocessing cache that `sem run` reads (sem/cache.h; --no-cache: not), and optionally
+ * save it to a file.
  *
  * Exit status: 0 on success; 1 when an option value is out of range or preprocessing
  * fails; 2 for malformed command lines (unknown option, missing or non-numeric values).
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "sem/cache.h"
 #include "sem/preprocess.h"
 #include "sem/simulation.h"
 
@@ -120,7 +122,7 @@ static void print_human(const char *path, const sem_discretization *d, double to
 int cmd_preprocess(int argc, char **argv)
 {
     const char *path = NULL, *save = NULL;
-    int json = 0, have_alpha = 0, have_sparsity = 0, modes = 1;
+    int json = 0, have_alpha = 0, have_sparsity = 0, modes = 1, use_cache = 1;
     double alpha = 0, sparsity = 0, blend = SEM_DEFAULT_BLEND;
     sem_preprocess_options o = sem_default_preprocess_options();
     int rc = CLI_OK;
@@ -184,6 +186,8 @@ int cmd_preprocess(int argc, char **argv)
             if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
             rc = cli_parse_int(CMD, a, argv[++i], &o.threads);
             if (rc == CLI_OK && o.threads < 0) rc = cli_fail("--threads must be >= 0 (got %d)", o.threads);
+        } else if (strcmp(a, "--no-cache") == 0) {
+            use_cache = 0;
         } else if (strcmp(a, "--save") == 0 || strcmp(a, "-o") == 0) {
             if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
             save = argv[++i];
@@ -201,6 +205,11 @@ int cmd_preprocess(int argc, char **argv)
         return cli_fail("give either --alpha or --sparsity, not both");
     if (have_alpha) o.alpha = alpha;
     if (have_sparsity) o.sparsity = sparsity;
+    if (o.threads > omp_get_num_procs()) {
+        cli_warn("--threads %d is more than the %d processors of this machine; using %d",
+                 o.threads, omp_get_num_procs(), omp_get_num_procs());
+        o.threads = omp_get_num_procs();
+    }
 
     sem_error err;
     sem_model *model = NULL;
@@ -219,9 +228,9 @@ int cmd_preprocess(int argc, char **argv)
     int *flags = calloc((size_t)d->n_parts + 1, sizeof *flags);
     if (!flags) st = sem_error_set(&err, SEM_ERR_NOMEM, "out of memory");
     if (st == SEM_OK && modes) st = find_modes(model, d, o.youngs_modulus, blend, &m, flags, &err);
-    sem_model_destroy(model);
     if (st != SEM_OK) {
         free(flags);
+        sem_model_destroy(model);
         sem_discretization_destroy(d);
         return cli_fail_error(path, &err);
     }
@@ -229,8 +238,19 @@ int cmd_preprocess(int argc, char **argv)
     if (save && sem_discretization_save(d, save, &err) != SEM_OK) {
         free(flags);
         sem_discretization_destroy(d);
+        sem_model_destroy(model);
         return cli_fail_error(save, &err);
     }
+    char cache[4096] = "";
+    if (use_cache) {
+        /* the entry `sem run` looks up for this model with these settings */
+        cli_cache_dir(cache, sizeof cache);
+        if (sem_cache_store(cache, cli_cache_max_bytes(), model, &o, d, &err) != SEM_OK) {
+            cli_warn("cannot write the cache: %s", err.message);
+            cache[0] = '\0';
+        }
+    }
+    sem_model_destroy(model);
     if (json) {
         cJSON *j = to_json(d, total_s);
         if (modes) add_modes_json(j, &m, flags, d->n_parts);
@@ -248,6 +268,7 @@ int cmd_preprocess(int argc, char **argv)
             }
         }
         if (save) printf("  saved                 %s\n", save);
+        if (cache[0]) printf("  cached in             %s (sem run reuses it)\n", cache);
     }
     free(flags);
     sem_discretization_destroy(d);

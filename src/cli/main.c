@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "sem/cache.h"
 #include "sem/version.h"
 
 typedef struct cli_command {
@@ -46,17 +47,22 @@ static const cli_command commands[] = {
     {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
      "  IN and OUT: .igs/.iges (IGES 5.3), .obj (OBJ free-form), .step/.stp (STEP, through\n"
      "  Open CASCADE; `sem --version` says when this build has no STEP support)\n"},
-    {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (40 40) across --axis (x)  --points-per-interval N (2)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (16)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n"},
-    {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--quiet]",
+    {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--rays N1 N2] [--axis x|y|z] [--points-per-interval N] [--alpha A | --sparsity T] [--gamma G] [-E E] [--tessellation N] [--threads N] [--json] [--save OUT] [--no-cache]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings", "  --order 1|2 (2)  --rays N1 N2 (40 40) across --axis (x)  --points-per-interval N (2)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)  --tessellation N (16)\n  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n  The result goes into the cache sem run reads ($SEM_CACHE_DIR, see sem run --help) unless --no-cache.\n"},
+    {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--overwrite] [--json] [--no-cache] [--quiet] | --resume DIR",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
-     "  SCENE       a scene file (JSON, see docs/scenes.md); without it the embedded default\n"
-     "              scene runs: a rubber beam clamped at x = 0 swinging under gravity\n"
-     "  --frames N  override the scene's frame count   --out DIR  override the output folder\n"
-     "  --json      print summary.json on stdout       --no-cache recompute the preprocessing\n"
-     "  --quiet     no progress output\n"
-     "  Preprocessed data is cached by model content and settings in $SEM_CACHE_DIR\n"
-     "  (default $XDG_CACHE_HOME/sem or ~/.cache/sem).\n"},
-    {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (5)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
+     "  SCENE        a scene file (JSON, see docs/scenes.md); without it the embedded default\n"
+     "               scene runs: a rubber beam clamped at x = 0 swinging under gravity\n"
+     "  --frames N   override the scene's frame count    --out DIR  override the output folder\n"
+     "  --overwrite  replace the files of another run in the output folder (else an error)\n"
+     "  --resume DIR continue the run in DIR (stopped by Ctrl-C, SIGTERM, kill -9, a crash) from\n"
+     "               its last complete frame; the result is that of an uninterrupted run\n"
+     "  --json       print summary.json on stdout        --no-cache recompute the preprocessing\n"
+     "  --quiet      no progress output\n"
+     "  Ctrl-C or SIGTERM: the frames so far, animation.usda and summary.json (status\n"
+     "  interrupted) are written, exit status 130 / 143. Preprocessed data is cached by model\n"
+     "  content and settings in $SEM_CACHE_DIR (default $XDG_CACHE_HOME/sem or ~/.cache/sem),\n"
+     "  at most $SEM_CACHE_MAX_MB megabytes (2048), least recently used entries removed first.\n"},
+    {"bench", cmd_bench, "[--json] [--models DIR] [--steps N] [--repeat N] [--solver S] [--only TEXT]", "the paper's Table 1 timings on the shared models, beside the paper's figures", "  --models DIR  shared models folder (default $SEM_SHARED_MODELS, ../shared/models, ../../shared/models)\n  --steps N     timed linearly implicit Euler steps per row after one warm-up step (20)\n  --solver S    auto (the fixed rule, default), sparse (CHOLMOD) or dense (LAPACK)\n  --repeat N    preprocessing runs per row; each phase reports its fastest run (5)\n  --only TEXT   rows whose example name or file contains TEXT\n  --json        a list of objects: example, file, dofs, sample_s, quad_s, weights_s, build_pi_s,\n                step_s, factor_s, nnz_percent (+ order, solver, scene_s, paper)\n"},
     {"render", cmd_render, "OUT_DIR | MODEL_FILE [-o OUT] [--mp4 FILE] [--size W H] [--frames A:B] [--camera AZ,EL[,DIST] | --camera EX,EY,EZ,TX,TY,TZ] [--color part|material|weights:PART|origins|quadrature]",
      "ray-traced pictures of a run's frames (PNG, optionally an MP4 video) or of a model at rest",
      "  OUT_DIR      a folder written by sem run: every frame -> OUT_DIR/render/frame_NNNN.png\n"
@@ -174,13 +180,49 @@ int cli_parse_double(const char *command, const char *option, const char *text, 
     return CLI_OK;
 }
 
+void cli_cache_dir(char *out, size_t size)
+{
+    const char *d = getenv("SEM_CACHE_DIR");
+    if (d && *d) {
+        snprintf(out, size, "%s", d);
+        return;
+    }
+    const char *x = getenv("XDG_CACHE_HOME");
+    if (x && *x) {
+        snprintf(out, size, "%s/sem", x);
+        return;
+    }
+    const char *h = getenv("HOME");
+    snprintf(out, size, "%s/.cache/sem", h && *h ? h : "/tmp");
+}
+
+long long cli_cache_max_bytes(void)
+{
+    const char *v = getenv("SEM_CACHE_MAX_MB");
+    if (v && *v) {
+        char *end;
+        errno = 0;
+        long long mb = strtoll(v, &end, 10);
+        if (errno == 0 && *end == '\0' && mb >= 0 && mb < (1LL << 40)) return mb << 20;
+        cli_warn("SEM_CACHE_MAX_MB='%s' is not a number of megabytes; using %lld", v,
+                 SEM_CACHE_DEFAULT_MAX_BYTES >> 20);
+    }
+    return SEM_CACHE_DEFAULT_MAX_BYTES;
+}
+
 int cli_parse_int(const char *command, const char *option, const char *text, int *out)
 {
     char *end;
     errno = 0;
     long x = strtol(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+    if (end == text || *end != '\0' || errno == ERANGE || x < INT_MIN || x > INT_MAX) {
+        /* "1e12" or 99999999999: an integer, only too large for the option */
+        errno = 0;
+        double d = strtod(text, &end);
+        if (end != text && *end == '\0' && isfinite(d) && d == floor(d) && fabs(d) > INT_MAX)
+            return cli_usage(command, "%s: %s is too large", option, text);
         return cli_usage(command, "%s: '%s' is not an integer", option, text);
+    }
     *out = (int)x;
     return CLI_OK;
 }

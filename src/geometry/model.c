@@ -1,5 +1,6 @@
 /* model.c - life cycle and bookkeeping of NURBS models (see sem/model.h). */
 #include "sem/model.h"
+#include "sem/limits.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -210,6 +211,41 @@ sem_status sem_model_add_part(sem_model *m, const sem_part *part, sem_error *err
     return SEM_OK;
 }
 
+/* Knot spans in use along one direction (distinct knots strictly inside the range, + 1). */
+static long long spans_in_use(int degree, int n, const double *knots, double t0, double t1)
+{
+    long long spans = 1;
+    for (int i = degree + 1; i < n; ++i)
+        spans += knots[i] > knots[i - 1] && knots[i] > t0 && knots[i] < t1;
+    return spans;
+}
+
+sem_status sem_model_check_limits(const sem_model *m, sem_error *err)
+{
+    if (m->n_parts > SEM_MAX_PARTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "the model has %d parts; at most %d are read "
+                                                   "(limit SEM_MAX_PARTS)",
+                             m->n_parts, SEM_MAX_PARTS);
+    /* per span: the basis functions one evaluation touches, times the Gauss points a span
+     * gets where it is integrated (measure.c: degree + 6, 8..24 per direction) */
+    double work = 0;
+    for (int i = 0; i < m->n_parts; ++i) {
+        const sem_surface *s = &m->parts[i].surface;
+        int gu = s->degree_u + 6 < 8 ? 8 : s->degree_u + 6 > 24 ? 24 : s->degree_u + 6;
+        int gv = s->degree_v + 6 < 8 ? 8 : s->degree_v + 6 > 24 ? 24 : s->degree_v + 6;
+        work += (double)spans_in_use(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1) *
+                (double)spans_in_use(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1) *
+                (s->degree_u + 1) * (s->degree_v + 1) * gu * gv;
+        if (work > SEM_MAX_MODEL_SPAN_WORK)
+            return sem_error_set(err, SEM_ERR_INVALID,
+                                 "the surfaces have too many knot spans for their degrees (part "
+                                 "%d reaches %.3g units of evaluation work; limit "
+                                 "SEM_MAX_MODEL_SPAN_WORK = %.3g)",
+                                 i + 1, work, (double)SEM_MAX_MODEL_SPAN_WORK);
+    }
+    return SEM_OK;
+}
+
 sem_model *sem_model_clone(const sem_model *src)
 {
     sem_model *m = sem_model_create();
@@ -227,11 +263,20 @@ sem_model *sem_model_clone(const sem_model *src)
 
 void sem_model_warn(sem_model *m, const char *fmt, ...)
 {
+    /* A file can repeat one unsupported entity a million times: keep the first
+     * SEM_MODEL_MAX_WARNINGS messages and one line that says how many were dropped. */
+    if (m->n_warnings > SEM_MODEL_MAX_WARNINGS) return;
     char buf[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
+    if (m->n_warnings == SEM_MODEL_MAX_WARNINGS) {
+        snprintf(buf, sizeof buf, "more than %d warnings; the rest are not shown",
+                 SEM_MODEL_MAX_WARNINGS);
+    } else {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(buf, sizeof buf, fmt, ap);
+        va_end(ap);
+        sem_text_sanitize(buf);
+    }
     char **w = realloc(m->warnings, (size_t)(m->n_warnings + 1) * sizeof *w);
     if (!w) return;
     m->warnings = w;

@@ -12,6 +12,7 @@
  * that runs counter-clockwise in the (rho, z) half-plane gives outward normals.
  */
 #include "sem/primitives.h"
+#include "sem/limits.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -191,9 +192,9 @@ sem_status sem_primitive_box(sem_model *model, const sem_box_def *def, sem_error
 
 sem_status sem_primitive_beam(sem_model *model, const sem_beam_def *def, sem_error *err)
 {
-    if (def->sections < 1 || def->sections > 100000)
-        return sem_error_set(err, SEM_ERR_INVALID, "beam sections %d out of range 1..100000",
-                             def->sections);
+    if (def->sections < 1 || def->sections > SEM_MAX_BEAM_SECTIONS)
+        return sem_error_set(err, SEM_ERR_INVALID, "beam sections %d out of range 1..%d",
+                             def->sections, SEM_MAX_BEAM_SECTIONS);
     if (!positive(def->length) || !positive(def->width) || !positive(def->height))
         return sem_error_set(err, SEM_ERR_INVALID,
                              "beam length %g, width %g and height %g must be positive",

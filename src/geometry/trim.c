@@ -8,6 +8,13 @@
  * Each curve is flattened per non-empty knot span finely enough (32 + 8 * degree points)
  * that the polygon departs from the curve by far less than any sampling spacing we use.
  * Queries are bucketed by v so that one query only visits the edges of its row.
+ *
+ * Bounds. A part's loops may hold at most SEM_MAX_TRIM_CURVES curves and
+ * SEM_MAX_TRIM_SEGMENTS knot spans in all (sem/limits.h), which bounds the polygons. An
+ * edge is stored once in every bucket its v range overlaps, so a loop of long zig-zag
+ * edges would fill every bucket: the bucket count is halved until the stored entries are
+ * at most a small multiple of the edges. Bucket indices are computed in floating point
+ * and clamped before the conversion to int (coordinates like 1e308 give inf and NaN).
  */
 #include "sem/trim.h"
 
@@ -16,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sem/limits.h"
 #include "sem/nurbs.h"
 
 typedef struct polygon {
@@ -55,6 +63,43 @@ static double dist2d(const double *a, const double *b)
     return hypot(a[0] - b[0], a[1] - b[1]);
 }
 
+/* floor(f) clamped to [0, n - 1]; NaN gives 0 (no undefined float-to-int conversion) */
+static int clamp_index(double f, int n)
+{
+    if (!(f > 0)) return 0;
+    if (f >= n - 1) return n - 1;
+    return (int)f;
+}
+
+/* Checks a part's trim loops against the curve and knot-span limits. */
+static sem_status check_trim_size(const sem_part *part, sem_error *err)
+{
+    long long curves = 0, spans = 0;
+    int n_loops = (part->has_outer ? 1 : 0) + part->n_holes;
+    for (int l = 0; l < n_loops; ++l) {
+        const sem_trim_loop *loop = part->has_outer && l == 0 ? &part->outer
+                                                              : &part->holes[l - part->has_outer];
+        curves += loop->n_curves;
+        for (int c = 0; c < loop->n_curves; ++c) {
+            const sem_curve *cv = &loop->curves[c];
+            /* distinct knots in range bound the spans */
+            long long n = 1;
+            for (int i = cv->degree + 1; i < cv->n_ctrl; ++i)
+                n += cv->knots[i] > cv->knots[i - 1] && cv->knots[i] > cv->t0 && cv->knots[i] < cv->t1;
+            spans += n;
+        }
+    }
+    if (curves > SEM_MAX_TRIM_CURVES)
+        return sem_error_set(err, SEM_ERR_INVALID, "trim loops have %lld curves; at most %d per "
+                                                   "part (limit SEM_MAX_TRIM_CURVES)",
+                             curves, SEM_MAX_TRIM_CURVES);
+    if (spans > SEM_MAX_TRIM_SEGMENTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "trim curves have %lld knot spans; at most %d "
+                                                   "per part (limit SEM_MAX_TRIM_SEGMENTS)",
+                             spans, SEM_MAX_TRIM_SEGMENTS);
+    return SEM_OK;
+}
+
 /* Flattens one loop. Curves may run either way; each is appended in the direction that
  * continues the chain. Returns SEM_OK or an error naming the gap. */
 static sem_status flatten_loop(const sem_trim_loop *loop, double tol, polygon *out,
@@ -65,8 +110,16 @@ static sem_status flatten_loop(const sem_trim_loop *loop, double tol, polygon *o
     double first[2] = {0, 0}, last[2] = {0, 0};
     for (int c = 0; c < loop->n_curves; ++c) {
         const sem_curve *cv = &loop->curves[c];
-        double breaks[4096];
-        int nb = sem_knot_breaks(cv->degree, cv->n_ctrl, cv->knots, cv->t0, cv->t1, breaks, 4096);
+        /* at most n_ctrl - degree + 1 breaks (distinct knots in range plus the ends) */
+        int max_breaks = cv->n_ctrl - cv->degree + 2;
+        double *breaks = malloc((size_t)max_breaks * sizeof *breaks);
+        if (!breaks) {
+            free(out->uv);
+            out->uv = NULL;
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory flattening a trim loop");
+        }
+        int nb = sem_knot_breaks(cv->degree, cv->n_ctrl, cv->knots, cv->t0, cv->t1, breaks,
+                                 max_breaks);
         int per = 32 + 8 * cv->degree;
         double a[3], b[3];
         sem_curve_eval(cv, cv->t0, a, NULL);
@@ -88,6 +141,7 @@ static sem_status flatten_loop(const sem_trim_loop *loop, double tol, polygon *o
             reverse = de < ds;
             double gap = fmin(ds, de);
             if (gap > tol) {
+                free(breaks);
                 free(out->uv);
                 out->uv = NULL;
                 return sem_error_set(err, SEM_ERR_INVALID,
@@ -106,11 +160,13 @@ static sem_status flatten_loop(const sem_trim_loop *loop, double tol, polygon *o
             sem_curve_eval(cv, t, x, NULL);
             if (c > 0 && k == 0) continue; /* shared with the previous curve's end */
             if (!push_point(out, &cap, x[0], x[1])) {
+                free(breaks);
                 free(out->uv);
                 out->uv = NULL;
                 return sem_error_set(err, SEM_ERR_NOMEM, "out of memory flattening a trim loop");
             }
         }
+        free(breaks);
         if (c == 0) {
             first[0] = out->uv[0];
             first[1] = out->uv[1];
@@ -155,6 +211,22 @@ static sem_status build_buckets(sem_trim_region *r)
     }
     int nb = (int)fmin(1024.0, fmax(1.0, sqrt((double)n_edges) * 2));
     if (!(v1 > v0)) v1 = v0 + 1.0;
+    if (!isfinite(v1 - v0)) nb = 1; /* coordinates near the double range: one bucket */
+    /* fewer buckets until the entries stay within 4 per edge (plus a few) */
+    for (;;) {
+        size_t entries = 0;
+        for (int l = 0; l < r->n_loops; ++l) {
+            const polygon *p = &r->loops[l];
+            for (int i = 0; i < p->n; ++i) {
+                const double *a = p->uv + 2 * i, *b = p->uv + 2 * ((i + 1) % p->n);
+                double lo = fmin(a[1], b[1]), hi = fmax(a[1], b[1]);
+                entries += (size_t)(clamp_index((hi - v0) / (v1 - v0) * nb, nb) -
+                                    clamp_index((lo - v0) / (v1 - v0) * nb, nb) + 1);
+            }
+        }
+        if (nb == 1 || entries <= 4 * n_edges + 4096) break;
+        nb /= 2;
+    }
     r->n_buckets = nb;
     r->bv0 = v0;
     r->bv1 = v1;
@@ -179,9 +251,8 @@ static sem_status build_buckets(sem_trim_region *r)
             for (int i = 0; i < p->n; ++i) {
                 const double *a = p->uv + 2 * i, *b = p->uv + 2 * ((i + 1) % p->n);
                 double lo = fmin(a[1], b[1]), hi = fmax(a[1], b[1]);
-                int b0 = (int)((lo - v0) / (v1 - v0) * nb), b1 = (int)((hi - v0) / (v1 - v0) * nb);
-                if (b0 < 0) b0 = 0;
-                if (b1 >= nb) b1 = nb - 1;
+                int b0 = clamp_index((lo - v0) / (v1 - v0) * nb, nb);
+                int b1 = clamp_index((hi - v0) / (v1 - v0) * nb, nb);
                 for (int bk = b0; bk <= b1; ++bk) {
                     if (pass == 0) {
                         r->bucket_start[bk + 1]++;
@@ -224,7 +295,7 @@ sem_status sem_trim_region_build(const sem_part *part, sem_trim_region **out, se
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     double tol = closure_tolerance(part);
-    sem_status st = SEM_OK;
+    sem_status st = check_trim_size(part, err);
     if (with_rect) {
         polygon *p = &r->loops[r->n_loops++];
         p->n = 4;
@@ -271,9 +342,7 @@ int sem_trim_region_inside(const sem_trim_region *r, double u, double v)
 {
     if (!r->trimmed) return u >= r->u0 && u <= r->u1 && v >= r->v0 && v <= r->v1;
     if (v < r->bv0 || v > r->bv1) return 0;
-    int b = (int)((v - r->bv0) / (r->bv1 - r->bv0) * r->n_buckets);
-    if (b >= r->n_buckets) b = r->n_buckets - 1;
-    if (b < 0) b = 0;
+    int b = clamp_index((v - r->bv0) / (r->bv1 - r->bv0) * r->n_buckets, r->n_buckets);
     int crossings = 0;
     for (int k = r->bucket_start[b]; k < r->bucket_start[b + 1]; ++k) {
         const double *e = r->edges + 4 * (size_t)k;

@@ -24,9 +24,16 @@
  * their coordinates exactly as written.
  *
  * Robustness. Any count read from the file is checked against the number of parameters the
- * entity actually has before anything is allocated, so memory is bounded by the file
- * size; recursion is bounded; malformed data ends the read with SEM_ERR_PARSE and
- * "FILE:LINE: entity T (DE n): what is wrong". Entities we cannot convert (parametric
+ * entity actually has before anything is allocated, so one entity cannot ask for more
+ * than the file holds. Sharing is what multiplies: a subfigure definition (308) may list
+ * the same member many times and be instanced by 408s inside other definitions, and a
+ * composite curve (102) may repeat one member, so a few kilobytes can describe 10^8
+ * surfaces. The busy flags only stop cycles; what bounds the work is a budget
+ * (sem/limits.h): every entity conversion counts against SEM_MAX_IGES_EXPANSION, every
+ * control point built (surfaces and curves, copies included) against
+ * SEM_MAX_MODEL_CONTROL_POINTS, and the file itself against SEM_MAX_MODEL_FILE_BYTES and
+ * SEM_MAX_IGES_ENTITIES. Recursion is bounded; malformed data ends the read with
+ * SEM_ERR_PARSE and "FILE:LINE: entity T (DE n): what is wrong". Entities we cannot convert (parametric
  * splines 112/114, conics, offset and analytic 190-198 surfaces, ...) are skipped with a
  * warning naming them, and a trim loop that cannot be built leaves its part untrimmed with
  * a warning rather than losing the part.
@@ -48,6 +55,8 @@
 
 #include "geometry/analytic_surfaces.h"
 #include "geometry/trim_projection.h"
+#include "io/read_file.h"
+#include "sem/limits.h"
 #include "sem/model.h"
 #include "sem/nurbs.h"
 #include "sem/trim.h"
@@ -84,7 +93,8 @@ typedef struct iges_entry {
     int n_used;      /* parameters of the definition (property pointers follow), 0 = unknown */
     unsigned char referenced;  /* pointed to by an entity we understand */
     unsigned char in_definition; /* member of a 308 subfigure definition */
-    unsigned char busy;        /* recursion guard */
+    unsigned char busy;        /* recursion guard (stops cycles, not repeated sharing) */
+    unsigned char self_ref;    /* points to itself: skipped with a warning */
 } iges_entry;
 
 typedef struct curve_list {
@@ -116,6 +126,8 @@ typedef struct iges_reader {
     int from_hint;
     int hint_fit;
     int hint_seam; /* the surface's seam may be turned to suit the boundary */
+    long long conversions;    /* entity conversions so far (SEM_MAX_IGES_EXPANSION) */
+    long long built_points;   /* control points built so far (SEM_MAX_MODEL_CONTROL_POINTS) */
 } iges_reader;
 
 enum { HINT_NONE, HINT_PLANE, HINT_AXIAL };
@@ -160,6 +172,27 @@ static sem_status entity_error(iges_reader *r, int idx, int line, const char *fm
 static sem_status nomem(iges_reader *r)
 {
     return sem_error_set(r->err, SEM_ERR_NOMEM, "%s: out of memory", r->name);
+}
+
+/* Counts one conversion of entity idx against the expansion budget. */
+static sem_status count_conversion(iges_reader *r, int idx)
+{
+    if (++r->conversions <= SEM_MAX_IGES_EXPANSION) return SEM_OK;
+    return entity_error(r, idx, 0, "more than %d entity conversions (subfigure instances and "
+                                   "shared members count each time they are used; limit "
+                                   "SEM_MAX_IGES_EXPANSION)",
+                        SEM_MAX_IGES_EXPANSION);
+}
+
+/* Counts n control points about to be built against the model budget. */
+static sem_status count_points(iges_reader *r, int idx, long long n)
+{
+    r->built_points += n;
+    if (r->built_points <= SEM_MAX_MODEL_CONTROL_POINTS) return SEM_OK;
+    return entity_error(r, idx, 0, "the model would have more than %d control points (surfaces "
+                                   "and trim curves, every instance counted; limit "
+                                   "SEM_MAX_MODEL_CONTROL_POINTS)",
+                        SEM_MAX_MODEL_CONTROL_POINTS);
 }
 
 static const char *entity_description(int type)
@@ -562,6 +595,10 @@ static sem_status read_directory(iges_reader *r)
     if (nd % 2 != 0)
         return parse_error(r, r->lines[r->sec_first[SEC_D] + nd - 1].number,
                            "odd number of Directory Entry lines (%d): each entry has 2", nd);
+    if (nd / 2 > SEM_MAX_IGES_ENTITIES)
+        return parse_error(r, r->lines[r->sec_first[SEC_D]].number,
+                           "%d directory entries; at most %d are read (limit "
+                           "SEM_MAX_IGES_ENTITIES)", nd / 2, SEM_MAX_IGES_ENTITIES);
     r->n_entries = nd / 2;
     r->entries = calloc((size_t)r->n_entries, sizeof *r->entries);
     if (!r->entries) return nomem(r);
@@ -1142,6 +1179,11 @@ static sem_status read_nurbs_curve(iges_reader *r, int idx, sem_curve *c)
     long long n = (long long)K + 1, nk = (long long)K + M + 2;
     st = need(r, idx, 7, nk + n + 3 * n + 2, "rational B-spline curve (K, M)");
     if (st != SEM_OK) return st;
+    if (nk > SEM_MAX_KNOTS)
+        return entity_error(r, idx, token_line(r, idx, 1), "%lld knots; at most %d per curve "
+                                                           "(limit SEM_MAX_KNOTS)",
+                            nk, SEM_MAX_KNOTS);
+    if ((st = count_points(r, idx, n)) != SEM_OK) return st;
     if (sem_curve_alloc(c, M, (int)n) != SEM_OK) return nomem(r);
     int k = 7;
     for (long long i = 0; st == SEM_OK && i < nk; ++i) st = param_real(r, idx, k++, &c->knots[i]);
@@ -1223,8 +1265,10 @@ static sem_status read_curves(iges_reader *r, int idx, const double *parent, int
     if (depth > IGES_MAX_DEPTH || e->busy)
         return entity_error(r, idx, 0, "entity references itself (cycle or nesting deeper than "
                                        "%d)", IGES_MAX_DEPTH);
+    sem_status st = count_conversion(r, idx);
+    if (st != SEM_OK) return st;
     double m[12];
-    sem_status st = own_xform(r, idx, parent, m);
+    st = own_xform(r, idx, parent, m);
     if (st != SEM_OK) return st;
     sem_curve c;
     memset(&c, 0, sizeof c);
@@ -1235,6 +1279,7 @@ static sem_status read_curves(iges_reader *r, int idx, const double *parent, int
     case 110: {
         double p0[3], p1[3];
         st = read_line(r, idx, p0, p1);
+        if (st == SEM_OK) st = count_points(r, idx, 2);
         if (st != SEM_OK) return st;
         if (sem_curve_alloc(&c, 1, 2) != SEM_OK) return nomem(r);
         memcpy(c.ctrl, p0, sizeof p0);
@@ -1244,7 +1289,8 @@ static sem_status read_curves(iges_reader *r, int idx, const double *parent, int
         break;
     }
     case 100:
-        st = read_arc(r, idx, &c);
+        st = count_points(r, idx, 9);
+        if (st == SEM_OK) st = read_arc(r, idx, &c);
         break;
     case 102: {
         int n;
@@ -1334,6 +1380,16 @@ static sem_status read_nurbs_surface(iges_reader *r, int idx, sem_surface *s)
     long long nk1 = n1 + M1 + 1, nk2 = n2 + M2 + 1;
     st = need(r, idx, 10, nk1 + nk2 + 4 * nw + 4, "rational B-spline surface (K1, K2, M1, M2)");
     if (st != SEM_OK) return st;
+    if (nk1 > SEM_MAX_KNOTS || nk2 > SEM_MAX_KNOTS)
+        return entity_error(r, idx, token_line(r, idx, 1), "%lld x %lld knots; at most %d per "
+                                                           "direction (limit SEM_MAX_KNOTS)",
+                            nk1, nk2, SEM_MAX_KNOTS);
+    if (nw > SEM_MAX_PART_CONTROL_POINTS)
+        return entity_error(r, idx, token_line(r, idx, 1), "%lld x %lld control points; at most "
+                                                           "%d per surface (limit "
+                                                           "SEM_MAX_PART_CONTROL_POINTS)",
+                            n1, n2, SEM_MAX_PART_CONTROL_POINTS);
+    if ((st = count_points(r, idx, nw)) != SEM_OK) return st;
     if (sem_surface_alloc(s, M1, M2, (int)n1, (int)n2) != SEM_OK) return nomem(r);
     s->closed_u = v[4];
     s->closed_v = v[5];
@@ -1712,8 +1768,10 @@ static sem_status read_surface(iges_reader *r, int idx, const double *parent, in
     if (depth > IGES_MAX_DEPTH || e->busy)
         return entity_error(r, idx, 0, "entity references itself (cycle or nesting deeper than "
                                        "%d)", IGES_MAX_DEPTH);
+    sem_status st = count_conversion(r, idx);
+    if (st != SEM_OK) return st;
     double m[12];
-    sem_status st = own_xform(r, idx, parent, m);
+    st = own_xform(r, idx, parent, m);
     if (st != SEM_OK) return st;
     e->busy = 1;
     switch (e->type) {
@@ -1732,8 +1790,13 @@ static sem_status read_surface(iges_reader *r, int idx, const double *parent, in
                                       : entity_error(r, idx, 0, "a surface was expected here");
     }
     e->busy = 0;
-    if (st != SEM_OK) return st;
     sem_surface *s = &part->surface;
+    if (st == SEM_OK && e->type != 128) {
+        /* analytic surfaces are built from their curves: count the net now */
+        st = count_points(r, idx, (long long)s->n_u * s->n_v);
+        if (st != SEM_OK) sem_part_free(part);
+    }
+    if (st != SEM_OK) return st;
     xf_apply(m, s->ctrl, (size_t)s->n_u * (size_t)s->n_v);
     sem_error ve;
     if (sem_surface_validate(s, &ve) != SEM_OK) {
@@ -1822,6 +1885,11 @@ static sem_status finish_part(iges_reader *r, sem_part *part, int top, int surf)
         label_name(r, surf, part->name, sizeof part->name);
     part->source_entity = de_number(surf);
     part->color = r->entries[top].color ? r->entries[top].color : r->entries[surf].color;
+    if (r->model->n_parts >= SEM_MAX_PARTS) {
+        sem_part_free(part);
+        return entity_error(r, top, 0, "the model would have more than %d parts (limit "
+                                       "SEM_MAX_PARTS)", SEM_MAX_PARTS);
+    }
     sem_error ve;
     if (sem_part_validate_trims(part, &ve) != SEM_OK) {
         sem_part_free(part);
@@ -2391,7 +2459,7 @@ static sem_status emit_instance(iges_reader *r, int idx, const double *parent, i
     for (int i = 0; st == SEM_OK && i < n; ++i) {
         int child;
         st = param_ptr(r, def, 4 + i, 0, &child);
-        if (st == SEM_OK) st = emit_entity(r, child, m, depth + 1);
+        if (st == SEM_OK && !r->entries[child].self_ref) st = emit_entity(r, child, m, depth + 1);
     }
     d->busy = 0;
     return st;
@@ -2401,6 +2469,8 @@ static sem_status emit_entity(iges_reader *r, int idx, const double *parent, int
 {
     if (depth > IGES_MAX_DEPTH)
         return entity_error(r, idx, 0, "entities nest deeper than %d", IGES_MAX_DEPTH);
+    sem_status cst = count_conversion(r, idx);
+    if (cst != SEM_OK) return cst;
     int type = r->entries[idx].type;
     switch (type) {
     case 108:
@@ -2438,11 +2508,16 @@ static void mark_references(iges_reader *r)
 {
     for (int i = 0; i < r->n_entries; ++i) {
         const iges_entry *e = &r->entries[i];
-        int n = 0, p, k, kk;
+        int n = 0, p, k, kk, self = 0;
         int list[8], nl = 0;
+        /* a pointer to the entity itself is not a reference: it would hide the entity
+         * (referenced entities are not emitted on their own) without a word */
 #define MARK(K)                                                                          \
     do {                                                                                 \
-        if (peek_ptr(r, i, (K), &p)) r->entries[p].referenced = 1;                       \
+        if (peek_ptr(r, i, (K), &p)) {                                                   \
+            if (p == i) self = 1;                                                        \
+            else r->entries[p].referenced = 1;                                           \
+        }                                                                                \
     } while (0)
         switch (e->type) {
         case 102:
@@ -2509,6 +2584,10 @@ static void mark_references(iges_reader *r)
             if (peek_int(r, i, 3, &n))
                 for (int j = 0; j < n && j < e->n_params; ++j)
                     if (peek_ptr(r, i, 4 + j, &p)) {
+                        if (p == i) {
+                            self = 1;
+                            continue;
+                        }
                         r->entries[p].referenced = 1;
                         r->entries[p].in_definition = 1;
                     }
@@ -2518,10 +2597,27 @@ static void mark_references(iges_reader *r)
         }
         for (int j = 0; j < nl; ++j) MARK(list[j]);
 #undef MARK
+        if (self) {
+            r->entries[i].self_ref = 1;
+            if (e->type == 308)
+                sem_model_warn(r->model, "entity 308 (DE %d): subfigure definition lists itself; "
+                                         "that member is ignored", de_number(i));
+            else
+                sem_model_warn(r->model, "entity %d (DE %d) points to itself; skipped", e->type,
+                               de_number(i));
+        }
     }
 }
 
 /* ------------------------------------------------------------- API ---- */
+
+static sem_status check_model(iges_reader *r)
+{
+    sem_error e;
+    sem_status st = sem_model_check_limits(r->model, &e);
+    if (st != SEM_OK) return sem_error_set(r->err, st, "%s: %s", r->name, e.message);
+    return SEM_OK;
+}
 
 sem_status sem_iges_read_buffer(const char *name, const char *data, size_t len,
                                 sem_model **out, sem_error *err)
@@ -2543,13 +2639,15 @@ sem_status sem_iges_read_buffer(const char *name, const char *data, size_t len,
     if (st == SEM_OK) mark_references(&r);
     for (int i = 0; st == SEM_OK && i < r.n_entries; ++i) {
         const iges_entry *e = &r.entries[i];
-        if (e->type == 0 || e->referenced || e->in_definition || e->type == 308) continue;
+        if (e->type == 0 || e->referenced || e->in_definition || e->type == 308 || e->self_ref)
+            continue;
         st = emit_entity(&r, i, identity_xf, 0);
     }
     free(r.lines);
     free(r.ptext);
     free(r.tokens);
     free(r.entries);
+    if (st == SEM_OK) st = check_model(&r);
     if (st != SEM_OK) {
         sem_model_destroy(r.model);
         return st;
@@ -2562,33 +2660,12 @@ sem_status sem_iges_read(const char *path, sem_model **out, sem_error *err)
 {
     if (out) *out = NULL;
     if (!path || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_iges_read: NULL argument");
-    FILE *f = fopen(path, "rb");
-    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, len = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        if (len == cap) {
-            char *b = realloc(buf, cap * 2);
-            if (!b) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = b;
-            cap *= 2;
-        }
-        size_t n = fread(buf + len, 1, cap - len, f);
-        len += n;
-        if (n == 0) break;
-    }
-    int failed = ferror(f);
-    fclose(f);
-    if (!buf) return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory reading the file", path);
-    if (failed) {
-        free(buf);
-        return sem_error_set(err, SEM_ERR_IO, "%s: read error", path);
-    }
-    sem_status st = sem_iges_read_buffer(path, buf, len, out, err);
+    char *buf = NULL;
+    size_t len = 0;
+    sem_status st = sem_read_file(path, SEM_MAX_MODEL_FILE_BYTES, "SEM_MAX_MODEL_FILE_BYTES", &buf,
+                                  &len, err);
+    if (st != SEM_OK) return st;
+    st = sem_iges_read_buffer(path, buf, len, out, err);
     free(buf);
     return st;
 }

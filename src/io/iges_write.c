@@ -29,6 +29,7 @@
 #include "sem/version.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -405,13 +406,21 @@ static void write_global(iges_writer *w, const sem_model *m, const char *path)
     snprintf(product, sizeof product, "%s", file);
     char *dot = strrchr(product, '.');
     if (dot && dot != product) *dot = '\0';
-    /* SOURCE_DATE_EPOCH makes the output reproducible byte for byte */
+    /* SOURCE_DATE_EPOCH (seconds since 1970, the reproducible-builds convention) replaces
+     * the clock, so that the same model gives the same bytes; a value that is not a plain
+     * number of seconds in years 1970..9999 is ignored */
     time_t now = time(NULL);
     const char *epoch = getenv("SOURCE_DATE_EPOCH");
-    if (epoch && *epoch) now = (time_t)strtoll(epoch, NULL, 10);
+    if (epoch && *epoch) {
+        char *end;
+        errno = 0;
+        long long v = strtoll(epoch, &end, 10);
+        if (errno == 0 && *end == '\0' && v >= 0 && v <= 253402300799LL) now = (time_t)v;
+    }
     struct tm tm_utc;
-    gmtime_r(&now, &tm_utc);
-    strftime(date, sizeof date, "%Y%m%d.%H%M%S", &tm_utc);
+    if (!gmtime_r(&now, &tm_utc)) memset(&tm_utc, 0, sizeof tm_utc);
+    if (strftime(date, sizeof date, "%Y%m%d.%H%M%S", &tm_utc) == 0)
+        snprintf(date, sizeof date, "19700101.000000");
     int unit_flag;
     char unit_name[16];
     units_of(m, &unit_flag, unit_name);

@@ -20,6 +20,12 @@
  * (relative) indices, "v/vt/vn" references, '#' comments and '\' line continuation.
  * Polygon statements (f, l, p, vt, vn ...) and 3D curves are skipped with a warning.
  * Every error names the file and line: "FILE:LINE: what is wrong".
+ *
+ * Bounds (sem/limits.h): the file size, the knots per direction, the control points of a
+ * surface and of the model. Trim references copy their curve, so the copies count against
+ * SEM_MAX_MODEL_CONTROL_POINTS like the surfaces do (one large curv2 referenced by many
+ * trim statements would otherwise multiply the memory). Every trim loop must close, as
+ * the IGES reader requires.
  */
 #include "sem/model.h"
 
@@ -33,8 +39,11 @@
 #include <string.h>
 
 #include "io/atomic_file.h"
+#include "io/read_file.h"
 #include "io/real_format.h"
+#include "sem/limits.h"
 #include "sem/nurbs.h"
+#include "sem/trim.h"
 
 /* ------------------------------------------------------------------------------------ */
 /* reading                                                                              */
@@ -115,6 +124,7 @@ typedef struct obj_reader {
     pending_surface *surfaces;
     int n_surfaces, cap_surfaces;
     int n_polygon_statements, n_skipped_curves, n_ignored;
+    long long built_points; /* control points referenced so far (SEM_MAX_MODEL_CONTROL_POINTS) */
 } obj_reader;
 
 static sem_status parse_error(obj_reader *r, sem_status st, const char *fmt, ...)
@@ -136,6 +146,18 @@ static sem_status parse_error(obj_reader *r, sem_status st, const char *fmt, ...
 static sem_status no_memory(obj_reader *r)
 {
     return parse_error(r, SEM_ERR_NOMEM, "out of memory");
+}
+
+/* Counts n control points (surface vertices, curve points, trim copies) against the model
+ * budget. */
+static sem_status count_points(obj_reader *r, long long n)
+{
+    r->built_points += n;
+    if (r->built_points <= SEM_MAX_MODEL_CONTROL_POINTS) return SEM_OK;
+    return parse_error(r, SEM_ERR_PARSE, "the model would have more than %d control points "
+                                         "(surfaces and trim curves, every trim reference "
+                                         "counted; limit SEM_MAX_MODEL_CONTROL_POINTS)",
+                       SEM_MAX_MODEL_CONTROL_POINTS);
 }
 
 static sem_status parse_real(obj_reader *r, const char *tok, double *out)
@@ -224,8 +246,10 @@ static sem_status knots_from_parm(obj_reader *r, const element *e, const double_
                 return parse_error(r, SEM_ERR_PARSE, "parm %s of a Bezier repeats %.17g", dir,
                                    parm->x[i]);
         size_t segments = np - 1;
-        if (segments > (size_t)(INT_MAX / 4) / (size_t)degree)
-            return parse_error(r, SEM_ERR_PARSE, "too many Bezier segments");
+        if (segments > (size_t)(SEM_MAX_KNOTS - 2 * degree - 2) / (size_t)degree)
+            return parse_error(r, SEM_ERR_PARSE, "parm %s: %zu Bezier segments of degree %d "
+                                                 "need more than %d knots (limit SEM_MAX_KNOTS)",
+                               dir, segments, degree, SEM_MAX_KNOTS);
         int n_ctrl = (int)segments * degree + 1;
         double *k = malloc((size_t)(n_ctrl + degree + 1) * sizeof *k);
         if (!k) return no_memory(r);
@@ -242,7 +266,9 @@ static sem_status knots_from_parm(obj_reader *r, const element *e, const double_
         return parse_error(r, SEM_ERR_PARSE,
                            "parm %s has %zu knots; degree %d needs at least %d", dir, np, degree,
                            2 * degree + 2);
-    if (np > (size_t)INT_MAX / 4) return parse_error(r, SEM_ERR_PARSE, "too many knots");
+    if (np > (size_t)SEM_MAX_KNOTS)
+        return parse_error(r, SEM_ERR_PARSE, "parm %s has %zu knots; at most %d (limit "
+                                             "SEM_MAX_KNOTS)", dir, np, SEM_MAX_KNOTS);
     double *k = malloc(np * sizeof *k);
     if (!k) return no_memory(r);
     memcpy(k, parm->x, np * sizeof *k);
@@ -285,6 +311,13 @@ static sem_status finish_surface(obj_reader *r)
                          "values needs %d x %d = %lld",
                          n_given, e->deg_u, e->deg_v, e->parm_u.n, e->parm_v.n, n_u, n_v,
                          (long long)n_u * n_v);
+    if (st == SEM_OK && (long long)n_u * n_v > SEM_MAX_PART_CONTROL_POINTS)
+        st = parse_error(r, SEM_ERR_PARSE, "surf has %d x %d control vertices; at most %d per "
+                                           "surface (limit SEM_MAX_PART_CONTROL_POINTS)",
+                         n_u, n_v, SEM_MAX_PART_CONTROL_POINTS);
+    if (st == SEM_OK && r->n_surfaces >= SEM_MAX_PARTS)
+        st = parse_error(r, SEM_ERR_PARSE, "more than %d surfaces (limit SEM_MAX_PARTS)",
+                         SEM_MAX_PARTS);
     pending_surface ps;
     memset(&ps, 0, sizeof ps);
     if (st == SEM_OK && sem_surface_alloc(&ps.part.surface, e->deg_u, e->deg_v, n_u, n_v) != SEM_OK)
@@ -414,6 +447,7 @@ static sem_status statement_surf(obj_reader *r, int ntok, char **tok)
         st = parse_real(r, tok[1 + i], &r->current.range[i]);
         if (st != SEM_OK) return st;
     }
+    if ((st = count_points(r, ntok - 5)) != SEM_OK) return st;
     for (int i = 5; i < ntok; ++i) {
         int idx = 0;
         st = resolve_index(r, tok[i], r->v.n / 4, "vertex", &idx);
@@ -429,6 +463,7 @@ static sem_status statement_curv2(obj_reader *r, int ntok, char **tok)
     sem_status st = begin_element(r, ELEMENT_CURV2);
     if (st != SEM_OK) return st;
     if (ntok < 3) return parse_error(r, SEM_ERR_PARSE, "curv2 needs at least 2 control points");
+    if ((st = count_points(r, ntok - 1)) != SEM_OK) return st;
     for (int i = 1; i < ntok; ++i) {
         int idx = 0;
         st = resolve_index(r, tok[i], r->vp.n / 3, "parameter vertex (vp)", &idx);
@@ -711,6 +746,8 @@ static sem_status resolve_trims(obj_reader *r)
                                        "curv2 index %d out of range (the file has %d)",
                                        t->curve + 1, r->n_curves);
                 sem_curve *cv = &loop->curves[c];
+                sem_status st = count_points(r, r->curves[t->curve].n_ctrl);
+                if (st != SEM_OK) return st;
                 if (sem_curve_copy(cv, &r->curves[t->curve]) != SEM_OK) return no_memory(r);
                 loop->n_curves = c + 1;
                 /* a reversed range only says which way the loop runs: inside/outside does
@@ -726,11 +763,22 @@ static sem_status resolve_trims(obj_reader *r)
                                        t->t0, t->t1, t->curve + 1, a, b);
             }
         }
+        if (ps->n_loops > 0) {
+            /* loops must close (as in IGES): an open loop has no inside, and every measure
+             * of the part (area, quadrature) would be meaningless */
+            sem_error verr;
+            sem_status st = sem_part_validate_trims(part, &verr);
+            if (st != SEM_OK) {
+                r->line = ps->line;
+                return parse_error(r, st == SEM_ERR_NOMEM ? SEM_ERR_NOMEM : SEM_ERR_PARSE,
+                                   "surf: %s", verr.message);
+            }
+        }
     }
     return SEM_OK;
 }
 
-static sem_status read_text(obj_reader *r, char *text, size_t len)
+static sem_status read_text(obj_reader *r, const char *text, size_t len)
 {
     int cap_tokens = MAX_TOKENS_START;
     char **tokens = malloc((size_t)cap_tokens * sizeof *tokens);
@@ -779,7 +827,7 @@ static sem_status read_text(obj_reader *r, char *text, size_t len)
     return resolve_trims(r);
 }
 
-static sem_status obj_read_text(const char *path, char *text, size_t len, sem_model **out,
+static sem_status obj_read_text(const char *path, const char *text, size_t len, sem_model **out,
                                 sem_error *err)
 {
     obj_reader r;
@@ -795,6 +843,11 @@ static sem_status obj_read_text(const char *path, char *text, size_t len, sem_mo
                            "%s:%d: no free-form surfaces ('surf') in the file", path, r.line);
     for (int i = 0; st == SEM_OK && i < r.n_surfaces; ++i)
         st = sem_model_take_part(r.model, &r.surfaces[i].part, err);
+    if (st == SEM_OK) {
+        sem_error e;
+        st = sem_model_check_limits(r.model, &e);
+        if (st != SEM_OK) sem_error_set(err, st, "%s: %s", path, e.message);
+    }
     if (st == SEM_OK) {
         if (!r.model->units[0]) strcpy(r.model->units, "M");
         if (r.n_polygon_statements)
@@ -817,35 +870,23 @@ sem_status sem_obj_read(const char *path, sem_model **out, sem_error *err)
 {
     if (out) *out = NULL;
     if (!path || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_obj_read: NULL argument");
-    FILE *f = fopen(path, "rb");
-    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     char *text = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (len + 65536 > cap) {
-            size_t nc = cap ? 2 * cap : 1 << 20;
-            char *t = realloc(text, nc);
-            if (!t) {
-                free(text);
-                fclose(f);
-                return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory", path);
-            }
-            text = t;
-            cap = nc;
-        }
-        size_t got = fread(text + len, 1, cap - len, f);
-        len += got;
-        if (got == 0) break;
-    }
-    int failed = ferror(f);
-    fclose(f);
-    if (failed) {
-        free(text);
-        return sem_error_set(err, SEM_ERR_IO, "%s: read error", path);
-    }
-    sem_status st = obj_read_text(path, text, len, out, err);
+    size_t len = 0;
+    sem_status st = sem_read_file(path, SEM_MAX_MODEL_FILE_BYTES, "SEM_MAX_MODEL_FILE_BYTES",
+                                  &text, &len, err);
+    if (st != SEM_OK) return st;
+    st = obj_read_text(path, text, len, out, err);
     free(text);
     return st;
+}
+
+sem_status sem_obj_read_buffer(const char *name, const char *data, size_t len, sem_model **out,
+                               sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!out || (!data && len > 0))
+        return sem_error_set(err, SEM_ERR_INVALID, "sem_obj_read_buffer: NULL argument");
+    return obj_read_text(name ? name : "<buffer>", data ? data : "", len, out, err);
 }
 
 /* ------------------------------------------------------------------------------------ */

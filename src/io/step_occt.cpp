@@ -19,6 +19,9 @@
  * in the file. An outer wire that is just the border of the surface's domain is dropped (the
  * part is untrimmed, as an IGES reader would see it). Lengths stay in the file's unit (the
  * reader is told that the session unit is the file's), and the model records that unit.
+ * As for every reader (sem/limits.h), only a regular file of at most SEM_MAX_MODEL_FILE_BYTES
+ * is handed to Open CASCADE, and the model it gives must pass sem_model_check_limits (parts,
+ * knot spans) with every surface within SEM_MAX_PART_CONTROL_POINTS.
  *
  * Writing. Each part becomes a face: its B-spline surface, and for a trimmed part edges made
  * from the loop curves on that surface (3D curves computed from them), joined into wires by
@@ -88,6 +91,8 @@
 
 extern "C" {
 #include "io/atomic_file.h"
+#include "io/read_file.h"
+#include "sem/limits.h"
 #include "sem/model.h"
 #include "sem/trim.h"
 }
@@ -205,6 +210,10 @@ std::vector<double> flat_knots(const TColStd_Array1OfReal &knots, const TColStd_
 sem_status surface_from_occt(const Handle(Geom_BSplineSurface) & b, sem_surface *s, sem_error *err)
 {
     int nu = b->NbUPoles(), nv = b->NbVPoles();
+    if ((long long)nu * nv > SEM_MAX_PART_CONTROL_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "%d x %d control points; at most %d per surface "
+                                                   "(limit SEM_MAX_PART_CONTROL_POINTS)",
+                             nu, nv, SEM_MAX_PART_CONTROL_POINTS);
     if (sem_surface_alloc(s, b->UDegree(), b->VDegree(), nu, nv) != SEM_OK)
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     TColStd_Array1OfReal uk(1, b->NbUKnots()), vk(1, b->NbVKnots());
@@ -603,16 +612,24 @@ TopoDS_Face face_from_part(const sem_part *part)
     return fix.Face();
 }
 
+/* Control points of a part: its surface's and its trim curves'. */
+long long part_control_points(const sem_part *part)
+{
+    long long n = (long long)part->surface.n_u * part->surface.n_v;
+    for (int c = 0; c < part->outer.n_curves; ++c) n += part->outer.curves[c].n_ctrl;
+    for (int h = 0; h < part->n_holes; ++h)
+        for (int c = 0; c < part->holes[h].n_curves; ++c) n += part->holes[h].curves[c].n_ctrl;
+    return n;
+}
+
 sem_status read_step(const char *path, sem_model **out, sem_error *err)
 {
+    sem_status checked = sem_check_regular_file(path, SEM_MAX_MODEL_FILE_BYTES,
+                                                "SEM_MAX_MODEL_FILE_BYTES", err);
+    if (checked != SEM_OK) return checked;
     STEPControl_Reader reader;
-    if (reader.ReadFile(path) != IFSelect_RetDone) {
-        FILE *f = fopen(path, "rb");
-        if (!f)
-            return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-        fclose(f);
+    if (reader.ReadFile(path) != IFSelect_RetDone)
         return sem_error_set(err, SEM_ERR_PARSE, "%s: not a STEP file Open CASCADE can read", path);
-    }
     /* the file's length unit: keep the geometry in it */
     TColStd_SequenceOfAsciiString lengths, angles, solid_angles;
     reader.FileUnits(lengths, angles, solid_angles);
@@ -629,7 +646,15 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
     snprintf(m->units, sizeof m->units, "%s", unit->ours);
     m->unit_to_meter = unit->mm / 1000.0;
     int index = 0;
+    long long built = 0; /* control points of the parts so far (SEM_MAX_MODEL_CONTROL_POINTS) */
     for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next(), ++index) {
+        /* an assembly may place one shape many times: its faces count every time */
+        if (m->n_parts >= SEM_MAX_PARTS) {
+            sem_model_destroy(m);
+            return sem_error_set(err, SEM_ERR_INVALID, "%s: the model would have more than %d parts "
+                                                       "(limit SEM_MAX_PARTS)",
+                                 path, SEM_MAX_PARTS);
+        }
         sem_part part;
         sem_error perr;
         sem_status st = part_from_face(TopoDS::Face(ex.Current()), index, &part, m, &perr);
@@ -643,6 +668,16 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
                 memset(&part.surface, 0, sizeof part.surface);
                 sem_part_free(&part);
                 part = keep;
+            }
+            built += part_control_points(&part);
+            if (built > SEM_MAX_MODEL_CONTROL_POINTS) {
+                sem_part_free(&part);
+                sem_model_destroy(m);
+                return sem_error_set(err, SEM_ERR_INVALID, "%s: the model would have more than %d "
+                                                           "control points (surfaces and trim "
+                                                           "curves; limit "
+                                                           "SEM_MAX_MODEL_CONTROL_POINTS)",
+                                     path, SEM_MAX_MODEL_CONTROL_POINTS);
             }
             st = sem_model_take_part(m, &part, &perr);
         }
@@ -658,6 +693,11 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
     if (m->n_parts == 0) {
         sem_model_destroy(m);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: the file has no faces", path);
+    }
+    sem_error lerr;
+    if (sem_model_check_limits(m, &lerr) != SEM_OK) {
+        sem_model_destroy(m);
+        return sem_error_set(err, lerr.status, "%s: %s", path, lerr.message);
     }
     *out = m;
     return SEM_OK;

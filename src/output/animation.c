@@ -142,8 +142,24 @@ sem_status sem_animation_write_preprocess(const sem_animation *a, int object, co
     return output_write_preprocess(path, d, err);
 }
 
+static sem_status add_frame(sem_animation *a, int frame, const double *const *q, int write_files,
+                            sem_error *err);
+
 sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *const *q, sem_error *err)
 {
+    return add_frame(a, frame, q, 1, err);
+}
+
+sem_status sem_animation_restore_frame(sem_animation *a, int frame, const double *const *q,
+                                       sem_error *err)
+{
+    return add_frame(a, frame, q, 0, err);
+}
+
+static sem_status add_frame(sem_animation *a, int frame, const double *const *q, int write_files,
+                            sem_error *err)
+{
+    int digits = a->def.frame_digits > 0 ? a->def.frame_digits : 4;
     sem_status st;
     /* the combined model's control points, object after object */
     size_t total = 0;
@@ -159,12 +175,12 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
     sem_model_set_q(a->combined, all);
     free(all);
     char path[4400];
-    if (a->def.write_iges) {
-        snprintf(path, sizeof path, "%s/frame_%04d.igs", a->dir, frame);
+    if (a->def.write_iges && write_files) {
+        snprintf(path, sizeof path, "%s/frame_%0*d.igs", a->dir, digits, frame);
         if ((st = sem_model_save(a->combined, path, err)) != SEM_OK) return st;
     }
-    if (a->def.write_obj) {
-        snprintf(path, sizeof path, "%s/frame_%04d_nurbs.obj", a->dir, frame);
+    if (a->def.write_obj && write_files) {
+        snprintf(path, sizeof path, "%s/frame_%0*d_nurbs.obj", a->dir, digits, frame);
         if ((st = sem_model_save(a->combined, path, err)) != SEM_OK) return st;
     }
     if (!a->def.write_mesh && !a->def.write_usd && !a->def.write_glb) return SEM_OK;
@@ -203,11 +219,12 @@ sem_status sem_animation_add_frame(sem_animation *a, int frame, const double *co
             free(nrm);
             return st;
         }
-        if (a->def.write_mesh) {
+        if (a->def.write_mesh && write_files) {
             if (a->n_objects == 1)
-                snprintf(path, sizeof path, "%s/frame_%04d_mesh.obj", a->dir, frame);
+                snprintf(path, sizeof path, "%s/frame_%0*d_mesh.obj", a->dir, digits, frame);
             else
-                snprintf(path, sizeof path, "%s/frame_%04d_object%d_mesh.obj", a->dir, frame, o);
+                snprintf(path, sizeof path, "%s/frame_%0*d_object%d_mesh.obj", a->dir, digits,
+                         frame, o);
             if ((st = sem_mesh_write_obj(&a->meshes[o], &view, path, err)) != SEM_OK) {
                 free(pts);
                 free(nrm);

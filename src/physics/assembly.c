@@ -216,60 +216,71 @@ sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian
         }
     }
     int nth = o->nthreads;
-    double energy_total = 0;
+    double energy_total = 0, share_energy[GRADIENT_SHARES] = {0};
     int bad = 0;
-    double *thread_energy = calloc((size_t)nth, sizeof(double));
-    if (!thread_energy) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    const int block = (o->n_quad + 4 * GRADIENT_SHARES - 1) / (4 * GRADIENT_SHARES) > 0
+                          ? (o->n_quad + 4 * GRADIENT_SHARES - 1) / (4 * GRADIENT_SHARES)
+                          : 1;
+    memset(o->grad_z_share, 0, (size_t)GRADIENT_SHARES * nz * sizeof(double));
 #pragma omp parallel num_threads(nth) reduction(| : bad)
     {
-        int t = omp_get_thread_num();
-        double *gz = o->grad_z_thread + (size_t)t * nz;
-        memset(gz, 0, nz * sizeof(double));
-        double energy = 0;
         for (int c0 = 0; c0 < o->n_quad; c0 += o->chunk) {
             int c1 = o->n_quad - c0 > o->chunk ? c0 + o->chunk : o->n_quad;
-            /* per point: F, psi, P, and N_p (static shares: deterministic for a fixed
-             * thread count) */
+            /* per point: F, psi, P, and N_p. Blocks of `block` points go to the
+             * GRADIENT_SHARES accumulators in turn (block b to share b mod S), whatever the
+             * thread count and the chunk size; each share sums its points in point order
+             * (continued from chunk to chunk), and the shares are added in order below, so
+             * the sums are the same bits on any number of threads. */
 #pragma omp for schedule(static)
-            for (int p = c0; p < c1; ++p) {
-                int r0 = W->row_start[p], r1 = W->row_start[p + 1];
-                const double *D = o->point_D + (size_t)p * ma * 3;
-                double zb[27] = {0}; /* sum_i w_i z_i */
-                for (int r = r0; r < r1; ++r) {
-                    const double *zi = o->z + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
-                }
-                double F[9];
-                for (int dd = 0; dd < 3; ++dd)
-                    for (int e = 0; e < 3; ++e) {
-                        double f = 0;
-                        for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
-                        F[dd * 3 + e] = f;
+            for (int sh = 0; sh < GRADIENT_SHARES; ++sh) {
+                double *gz = o->grad_z_share + (size_t)sh * nz;
+                double energy = share_energy[sh];
+                for (int p = c0; p < c1; ++p) {
+                    if ((p / block) % GRADIENT_SHARES != sh) {
+                        /* skip to the next block */
+                        p += block - 1 - p % block;
+                        continue;
                     }
-                double P[9], H[81];
-                double vol = d->quad_volume[p];
-                double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
-                if (!isfinite(psi)) {
-                    bad = 1;
-                    if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
-                    continue;
-                }
-                energy += vol * psi;
-                /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
-                double v[27];
-                for (int k = 0; k < ma; ++k)
+                    int r0 = W->row_start[p], r1 = W->row_start[p + 1];
+                    const double *D = o->point_D + (size_t)p * ma * 3;
+                    double zb[27] = {0}; /* sum_i w_i z_i */
+                    for (int r = r0; r < r1; ++r) {
+                        const double *zi = o->z + (size_t)W->col[r] * ma * 3;
+                        double w = W->val[r];
+                        for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
+                    }
+                    double F[9];
                     for (int dd = 0; dd < 3; ++dd)
-                        v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
-                                               P[dd * 3 + 2] * D[k * 3 + 2]);
-                for (int r = r0; r < r1; ++r) {
-                    double *gzi = gz + (size_t)W->col[r] * ma * 3;
-                    double w = W->val[r];
-                    for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
+                        for (int e = 0; e < 3; ++e) {
+                            double f = 0;
+                            for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
+                            F[dd * 3 + e] = f;
+                        }
+                    double P[9], H[81];
+                    double vol = d->quad_volume[p];
+                    double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);
+                    if (!isfinite(psi)) {
+                        bad = 1;
+                        if (want_hessian) memset(o->N_chunk + (size_t)(p - c0) * np, 0, (size_t)np * sizeof(double));
+                        continue;
+                    }
+                    energy += vol * psi;
+                    /* d psi / d z_i[k][d] = vol w_i sum_e P[d][e] D[k][e] */
+                    double v[27];
+                    for (int k = 0; k < ma; ++k)
+                        for (int dd = 0; dd < 3; ++dd)
+                            v[k * 3 + dd] = vol * (P[dd * 3 + 0] * D[k * 3 + 0] + P[dd * 3 + 1] * D[k * 3 + 1] +
+                                                   P[dd * 3 + 2] * D[k * 3 + 2]);
+                    for (int r = r0; r < r1; ++r) {
+                        double *gzi = gz + (size_t)W->col[r] * ma * 3;
+                        double w = W->val[r];
+                        for (int x = 0; x < n3; ++x) gzi[x] += w * v[x];
+                    }
+                    if (!want_hessian) continue;
+                    if (!o->exact_hessian) sem_project_psd_9x9(H);
+                    point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
                 }
-                if (!want_hessian) continue;
-                if (!o->exact_hessian) sem_project_psd_9x9(H);
-                point_stiffness(ma, vol, H, D, o->N_chunk + (size_t)(p - c0) * np);
+                share_energy[sh] = energy;
             }
             if (!want_hessian) continue;
             /* per upper part pair: Kz_ab += sum_p w_a w_b N_p over the chunk's points, each
@@ -305,19 +316,17 @@ sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian
                 }
             }
         }
-        thread_energy[t] = energy;
     }
-    for (int t = 0; t < nth; ++t) energy_total += thread_energy[t];
-    free(thread_energy);
+    for (int sh = 0; sh < GRADIENT_SHARES; ++sh) energy_total += share_energy[sh];
     if (bad)
         return sem_error_set(err, SEM_ERR_NUMERIC,
                              "an element inverted or the state became non-finite (elastic energy "
                              "undefined)");
     o->elastic_energy = energy_total;
-    /* reduce in thread order */
-    memcpy(o->grad_z, o->grad_z_thread, nz * sizeof(double));
-    for (int t = 1; t < nth; ++t)
-        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_thread[(size_t)t * nz + k];
+    /* reduce in share order */
+    memcpy(o->grad_z, o->grad_z_share, nz * sizeof(double));
+    for (int sh = 1; sh < GRADIENT_SHARES; ++sh)
+        for (size_t k = 0; k < nz; ++k) o->grad_z[k] += o->grad_z_share[(size_t)sh * nz + k];
     if (grad_q) {
         memset(grad_q, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
         for (int i = 0; i < o->n_parts; ++i) {

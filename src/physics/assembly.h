@@ -25,15 +25,23 @@
  * Every per-point Hessian is projected to positive semi-definite unless the object's
  * exact_hessian is set (Newton near a minimum; see integrators.h).
  *
- * Determinism: per-thread accumulators reduced in thread order, per-pair sums in point
- * order by one thread each; the thread count is fixed by the world definition (or
- * OMP_NUM_THREADS).
+ * Determinism: the same bits on any thread count. The per-point sums (gradient, energy) go
+ * to GRADIENT_SHARES fixed accumulators added in order (below); per-pair sums are in point
+ * order by one thread each.
  */
 #ifndef SEM_PHYSICS_ASSEMBLY_H
 #define SEM_PHYSICS_ASSEMBLY_H
 
 #include "object.h"
 #include "system.h"
+
+/* The per-point loop of the elastic assembly sums into this many gradient and energy
+ * accumulators (o->grad_z_share), each over fixed blocks of points, added in order
+ * afterwards: the result is the same bits on any thread count (a per-thread accumulator
+ * would depend on it). Blocks are n_quad / (4 x GRADIENT_SHARES) points (rounded up), so
+ * every share gets 4 blocks (+-1) and the shares, spread statically over the threads, have
+ * equal work. It caps that loop's parallelism at 16 threads. */
+#define GRADIENT_SHARES 16
 
 /* assembly.c: the shared basis, the point lists of the part pairs and the work space of
  * the elastic terms; assembly_chunk points are summed at a time (<= 0: 8192). */

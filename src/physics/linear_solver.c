@@ -1,6 +1,7 @@
 /* linear_solver.c - CHOLMOD and dense LAPACK Cholesky behind one interface (see header). */
 #include "linear_solver.h"
 
+#include <cblas.h>
 #include <lapacke.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -16,6 +17,22 @@
  * of the 1800-dof mug). The caller's pattern positions are remapped once
  * (sem_linear_solver_remap); solves permute b and x.
  */
+/* The rule of SEM_SOLVER_AUTO: dense LAPACK up to this many (free) degrees of freedom,
+ * CHOLMOD above. Measured (docs/reliability.md): below ~500 dofs both factor in well under a
+ * millisecond and dense has no analysis to amortize; from the paper's smallest Table 1 row
+ * (648 dofs, a nearly full factor) on, CHOLMOD's supernodal factorization (BLAS on its
+ * supernodes) was as fast or faster on every row, which is also what the former timing
+ * rule chose for all twelve rows. */
+#define SEM_DENSE_MAX_DOFS 500
+
+/* OpenBLAS threads for the factorizations and solves, whatever the thread setting: its
+ * Cholesky (dense, and on CHOLMOD's supernodes) blocks the work by its thread count, so 1
+ * and 2 threads give different bits (measured: the default beam's first step). A fixed
+ * count makes the result independent of OMP_NUM_THREADS, the scene's threads and the
+ * machine's core count (docs/reliability.md); 2 is what the 2-core machines this was tuned
+ * on use anyway. */
+#define SEM_SOLVER_BLAS_THREADS 2
+
 /* The residual A x is summed in this many column shares, whatever the thread count, so
  * it gives the same bits on any number of threads. */
 #define RESIDUAL_SHARES 4
@@ -23,8 +40,7 @@
 struct sem_linear_solver {
     int n;
     size_t nnz;
-    sem_solver_choice choice; /* resolved to SPARSE or DENSE after the first factorization */
-    int decided;
+    sem_solver_choice choice; /* SPARSE or DENSE (AUTO resolved at creation) */
     cholmod_common common;
     cholmod_sparse *A;  /* P A P^T, lower, sorted */
     int *perm;          /* perm[k] = the caller's index of row/column k of A */
@@ -56,8 +72,11 @@ sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
     if (!s) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory creating the solver");
     s->n = n;
     s->nnz = (size_t)col_start[n];
-    s->choice = choice;
-    s->decided = choice != SEM_SOLVER_AUTO;
+    /* SEM_SOLVER_AUTO is a fixed rule, never a timing: the same system gets the same solver,
+     * and so the same bits, on every run and machine (docs/reliability.md). */
+    s->choice = choice != SEM_SOLVER_AUTO ? choice
+                : n <= SEM_DENSE_MAX_DOFS    ? SEM_SOLVER_DENSE
+                                             : SEM_SOLVER_SPARSE;
     cholmod_start(&s->common);
     s->common.print = 0;
     s->common.error_handler = NULL;
@@ -199,35 +218,12 @@ static sem_status factor_dense(sem_linear_solver *s, sem_error *err)
 
 sem_status sem_linear_solver_factorize(sem_linear_solver *s, sem_error *err)
 {
-    if (!s->decided) {
-        /* Measure both once (the sparse one after its one-off analysis) and keep the faster. */
-        sem_status st = factor_sparse(s, err);
-        if (st != SEM_OK) return st;
-        double t0 = omp_get_wtime();
-        st = factor_sparse(s, err);
-        double t_sparse = omp_get_wtime() - t0;
-        if (st != SEM_OK) return st;
-        double t_dense = 1e300;
-        if ((double)s->n * s->n * sizeof(double) < 2e9) {
-            t0 = omp_get_wtime();
-            st = factor_dense(s, err);
-            t_dense = omp_get_wtime() - t0;
-            if (st != SEM_OK) return st;
-        }
-        s->choice = t_dense < t_sparse ? SEM_SOLVER_DENSE : SEM_SOLVER_SPARSE;
-        s->decided = 1;
-        s->last_factor_s = t_dense < t_sparse ? t_dense : t_sparse;
-        if (s->choice == SEM_SOLVER_SPARSE) {
-            free(s->dense);
-            s->dense = NULL;
-        } else if (s->L) {
-            cholmod_free_factor(&s->L, &s->common);
-        }
-        return SEM_OK;
-    }
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(SEM_SOLVER_BLAS_THREADS);
     double t0 = omp_get_wtime();
     sem_status st = s->choice == SEM_SOLVER_DENSE ? factor_dense(s, err) : factor_sparse(s, err);
     s->last_factor_s = omp_get_wtime() - t0;
+    openblas_set_num_threads(blas_threads);
     return st;
 }
 
@@ -295,6 +291,8 @@ sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double
 {
     size_t n = (size_t)s->n;
     double *bp = s->work, *xp = s->work + n, *r = s->work + 2 * n;
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(SEM_SOLVER_BLAS_THREADS);
     for (size_t k = 0; k < n; ++k) bp[k] = b[s->perm[k]];
     sem_status st = solve_once(s, bp, xp, err);
     if (st == SEM_OK) {
@@ -303,6 +301,7 @@ sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double
         if (st == SEM_OK)
             for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k] + r[k];
     }
+    openblas_set_num_threads(blas_threads);
     return st;
 }
 

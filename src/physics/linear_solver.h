@@ -3,9 +3,9 @@
  *
  * The matrix pattern (upper triangle, CSC) is fixed for a simulation, so the symbolic
  * analysis is done once (cholmod_analyze) and only the numeric factorization is repeated
- * every step, as CHOLMOD intends. Small SEM models are nearly dense (Table 1's Nnz is
- * 100% for many of them), where LAPACK's blocked dense Cholesky beats any sparse code:
- * with SEM_SOLVER_AUTO the first factorization runs both and keeps the faster.
+ * every step, as CHOLMOD intends. Small SEM systems are nearly dense; with SEM_SOLVER_AUTO
+ * a fixed rule by size picks dense LAPACK for the smallest and CHOLMOD for the rest (see
+ * SEM_DENSE_MAX_DOFS), so that the same scene gives the same bits on every run.
  */
 #ifndef SEM_LINEAR_SOLVER_H
 #define SEM_LINEAR_SOLVER_H

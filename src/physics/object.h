@@ -101,7 +101,7 @@ typedef struct sem_object {
     double *Kz;                /* n_pairs x (3ma)^2, for pairs with points (Kz_ba = Kz_ab) */
     int nthreads;
     int exact_hessian;         /* 1: skip the PSD projection (Newton near a minimum) */
-    double *grad_z_thread;
+    double *grad_z_share;      /* GRADIENT_SHARES x n_parts*ma x 3 (see assembly.h) */
     double *qc;                /* q minus its mean, 3 n_ctrl (see sem_centered) */
     double elastic_energy;
     double volume, mass;

@@ -130,7 +130,7 @@ static void object_destroy(sem_object *o)
     free(o->grad_z);
     free(o->Kz);
     free(o->qc);
-    free(o->grad_z_thread);
+    free(o->grad_z_share);
     free((void *)o->def.point_loads);
     free((void *)o->def.region_loads);
     free(o);
@@ -245,9 +245,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
     if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
-    o->grad_z_thread = malloc(((size_t)o->nthreads * o->n_parts * o->ma * 3 + 1) * sizeof(double));
+    o->grad_z_share =
+        malloc(((size_t)GRADIENT_SHARES * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
-    if (!o->qc || !o->grad_z_thread) {
+    if (!o->qc || !o->grad_z_share) {
         sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -315,6 +316,7 @@ fail:
 /* queries                                                                             */
 
 double sem_world_time(const sem_world *w) { return w->time; }
+void sem_world_set_time(sem_world *w, double time) { w->time = time; }
 int sem_world_object_count(const sem_world *w) { return w->n_objects; }
 int sem_world_object_dofs(const sem_world *w, int i) { return 3 * w->objects[i]->n_ctrl; }
 const double *sem_world_object_q(const sem_world *w, int i) { return w->objects[i]->q; }

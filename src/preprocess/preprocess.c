@@ -37,6 +37,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/read_file.h"
+#include "sem/limits.h"
 #include "steps.h"
 
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
@@ -71,8 +73,8 @@ sem_preprocess_options sem_default_preprocess_options(void)
 }
 
 /* Upper bounds that keep a typo from asking for unbounded memory or time. */
-#define MAX_RAYS_PER_AXIS 4096
-#define MAX_POINTS_PER_INTERVAL 10000
+#define MAX_RAYS_PER_AXIS SEM_MAX_RAYS_PER_AXIS
+#define MAX_POINTS_PER_INTERVAL SEM_MAX_POINTS_PER_INTERVAL
 #define MAX_TESSELLATION 1024
 
 static sem_status validate_options(const sem_preprocess_options *o, sem_error *err)
@@ -316,6 +318,70 @@ static int model_is_flat(const sem_model *model)
     return lmin / (double)n <= 1e-20 * diag2;
 }
 
+/* Knot spans in use along one direction. */
+static double spans_in_use(int degree, int n, const double *knots, double t0, double t1)
+{
+    double spans = 1;
+    for (int i = degree + 1; i < n; ++i)
+        spans += knots[i] > knots[i - 1] && knots[i] > t0 && knots[i] < t1;
+    return spans;
+}
+
+/* What the settings and the model would make the steps build, estimated before any of it
+ * is built (sem/limits.h): a small file can hold a surface of degree 31 whose boundary
+ * samples each touch 1024 control points (3.6 GB of J-hat for a 70 KB file), and a ray grid
+ * or tessellation can be set to billions of rays or triangles. The genuine size of a model
+ * (many parts coupled by the weights) is not limited here. */
+static sem_status check_sizes(const sem_model *model, const sem_preprocess_options *o,
+                              sem_error *err)
+{
+    double entries = 0, triangles = 0, ctrl = 0;
+    for (int i = 0; i < model->n_parts; ++i) {
+        const sem_part *part = &model->parts[i];
+        const sem_surface *s = &part->surface;
+        int trimmed = part->has_outer || part->n_holes > 0;
+        double su = spans_in_use(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1);
+        double sv = spans_in_use(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1);
+        /* sampling.c: (degree + 1) Lobatto points per span, at least 24 (+ a span's worth)
+         * per direction on a trimmed part; each sample holds (p + 1)(q + 1) basis values */
+        double pu = s->degree_u + 1 < 2 ? 2 : s->degree_u + 1;
+        double pv = s->degree_v + 1 < 2 ? 2 : s->degree_v + 1;
+        double nu = su * pu, nv = sv * pv;
+        if (trimmed) {
+            nu = fmax(nu, 24 + 2 * pu);
+            nv = fmax(nv, 24 + 2 * pv);
+        }
+        entries += nu * nv * (s->degree_u + 1) * (s->degree_v + 1);
+        triangles += 2.0 * su * sv * o->tessellation * o->tessellation;
+        ctrl += (double)s->n_u * s->n_v;
+    }
+    if (ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
+                                                   "takes at most %d (limit "
+                                                   "SEM_MAX_PREPROCESS_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+    if (entries > SEM_MAX_BOUNDARY_ENTRIES)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "boundary sampling would store %.3g basis values (samples times "
+                             "the (degree + 1)^2 control points each touches; limit "
+                             "SEM_MAX_BOUNDARY_ENTRIES = %.3g): lower the surfaces' degree or "
+                             "knot count",
+                             entries, (double)SEM_MAX_BOUNDARY_ENTRIES);
+    if (triangles > SEM_MAX_TRIANGLES)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "tessellation %d would make %.3g triangles (limit "
+                             "SEM_MAX_TRIANGLES = %.3g): lower the tessellation",
+                             o->tessellation, triangles, (double)SEM_MAX_TRIANGLES);
+    double points = (double)o->rays[0] * o->rays[1] * o->points_per_interval;
+    if (points > SEM_MAX_QUADRATURE_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "rays %d x %d with %d points per interval would make at least %.3g "
+                             "quadrature points (limit SEM_MAX_QUADRATURE_POINTS = %.3g)",
+                             o->rays[0], o->rays[1], o->points_per_interval, points,
+                             (double)SEM_MAX_QUADRATURE_POINTS);
+    return SEM_OK;
+}
+
 sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *options,
                           sem_discretization **out, sem_error *err)
 {
@@ -333,6 +399,8 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     if (model_is_flat(model))
         return sem_error_set(err, SEM_ERR_INVALID,
                              "model encloses no volume (all its surfaces lie in one plane)");
+    st = check_sizes(model, &o, err);
+    if (st != SEM_OK) return st;
 
     int saved_threads = omp_get_max_threads();
     if (o.threads > 0) omp_set_num_threads(o.threads);
@@ -705,47 +773,42 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
 {
     if (out) *out = NULL;
     if (!path || !out) return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_load: NULL argument");
-    FILE *f = fopen(path, "rb");
-    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat sb;
-    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_IO, "%s: not a regular file", path);
-    }
-    size_t size = (size_t)sb.st_size;
+    char *data = NULL;
+    size_t size = 0;
+    sem_status st = sem_read_file(path, SEM_MAX_CACHE_FILE_BYTES, "SEM_MAX_CACHE_FILE_BYTES", &data,
+                                  &size, err);
+    if (st != SEM_OK) return st;
+    st = sem_discretization_load_buffer(path, data, size, expected_hash, out, err);
+    free(data);
+    return st;
+}
+
+sem_status sem_discretization_load_buffer(const char *name, const void *bytes, size_t size,
+                                          unsigned long long expected_hash,
+                                          sem_discretization **out, sem_error *err)
+{
+    if (out) *out = NULL;
+    if (!out || (!bytes && size > 0))
+        return sem_error_set(err, SEM_ERR_INVALID, "sem_discretization_load_buffer: NULL argument");
+    const char *path = name ? name : "<buffer>";
+    const unsigned char *data = bytes;
     const size_t header = sizeof sem_disc_magic + 4 + 4 + 8;
-    if (size < header + 8) {
-        fclose(f);
+    if (size < header + 8)
         return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (too short)", path);
-    }
-    unsigned char *data = malloc(size);
-    if (!data) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, size);
-    }
-    size_t got = fread(data, 1, size, f);
-    fclose(f);
-    if (got != size) {
-        free(data);
-        return sem_error_set(err, SEM_ERR_IO, "%s: read failed", path);
-    }
 
     reader r = {data, size, 0, path, err, SEM_OK};
     char magic[8];
     r_bytes(&r, magic, sizeof magic);
     if (memcmp(magic, sem_disc_magic, sizeof magic) != 0) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: not a sem preprocessed file (bad magic)", path);
     }
     uint32_t version = r_u32(&r);
     uint32_t bom = r_u32(&r);
     if (bom != SEM_DISC_BYTE_ORDER) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: written on a machine of another byte order",
                              path);
     }
     if (version != SEM_DISC_FORMAT_VERSION) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE, "%s: written by format version %u, this sem reads %u",
                              path, (unsigned)version, (unsigned)SEM_DISC_FORMAT_VERSION);
     }
@@ -756,14 +819,12 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
     uint64_t stored;
     memcpy(&stored, data + size - 8, 8);
     if (stored != sum.h) {
-        free(data);
         return sem_error_set(err, SEM_ERR_PARSE,
                              "%s: corrupt preprocessed data: checksum mismatch (truncated or damaged file)",
                              path);
     }
     uint64_t hash = r_u64(&r);
     if (expected_hash != 0 && hash != (uint64_t)expected_hash) {
-        free(data);
         return sem_error_set(err, SEM_ERR_INVALID,
                              "%s: preprocessed data is for a different model or settings", path);
     }
@@ -771,7 +832,6 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
 
     sem_discretization *d = calloc(1, sizeof *d);
     if (!d) {
-        free(data);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     d->model_hash = hash;
@@ -851,7 +911,6 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
                     r_fail(&r, "bad part_ctrl_offset");
         }
     }
-    free(data);
     if (r.st != SEM_OK) {
         sem_discretization_destroy(d);
         return r.st;

@@ -16,6 +16,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/read_file.h"
+#include "sem/limits.h"
 #include "sem/primitives.h"
 
 typedef struct ctx {
@@ -74,8 +76,10 @@ static sem_status get_int(ctx *c, const cJSON *obj, const char *key, const char 
     if (!v) return SEM_OK;
     char w[256];
     snprintf(w, sizeof w, "%s.%s", where, key);
-    if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble) || fabs(v->valuedouble) > 1e9)
+    if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble))
         return fail(c, w, "must be an integer");
+    if (fabs(v->valuedouble) > 1e9)
+        return fail(c, w, "%g is too large (at most 1000000000)", v->valuedouble);
     *out = (int)v->valuedouble;
     return SEM_OK;
 }
@@ -280,9 +284,9 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
         double rr[2];
         snprintf(w, sizeof w, "%s.rays", where);
         if ((st = vec_n(c, r, w, 2, rr)) != SEM_OK) return st;
-        if (rr[0] < 1 || rr[1] < 1 || rr[0] > 10000 || rr[1] > 10000 || rr[0] != floor(rr[0]) ||
-            rr[1] != floor(rr[1]))
-            return fail(c, w, "must be two integers in 1..10000");
+        if (rr[0] < 1 || rr[1] < 1 || rr[0] > SEM_MAX_RAYS_PER_AXIS ||
+            rr[1] > SEM_MAX_RAYS_PER_AXIS || rr[0] != floor(rr[0]) || rr[1] != floor(rr[1]))
+            return fail(c, w, "must be two integers in 1..%d", SEM_MAX_RAYS_PER_AXIS);
         o->rays[0] = (int)rr[0];
         o->rays[1] = (int)rr[1];
     }
@@ -317,9 +321,10 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
     if (ppi && !cJSON_IsNull(ppi)) {
         if ((st = get_int(c, s, "points_per_interval", where, &o->points_per_interval)) != SEM_OK)
             return st;
-        if (o->points_per_interval < 1 || o->points_per_interval > 10000) {
+        if (o->points_per_interval < 1 || o->points_per_interval > SEM_MAX_POINTS_PER_INTERVAL) {
             snprintf(w, sizeof w, "%s.points_per_interval", where);
-            return fail(c, w, "must be in 1..10000 or null (got %d)", o->points_per_interval);
+            return fail(c, w, "must be in 1..%d or null (got %d)", SEM_MAX_POINTS_PER_INTERVAL,
+                        o->points_per_interval);
         }
     }
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(s, "gamma");
@@ -527,10 +532,11 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             }
         }
         const cJSON *sec = cJSON_GetObjectItemCaseSensitive(prim, "sections");
-        if (sec && (obj->primitive_sections < 1 || obj->primitive_sections > 10000)) {
+        if (sec && (obj->primitive_sections < 1 || obj->primitive_sections > SEM_MAX_BEAM_SECTIONS)) {
             char wk[300];
             snprintf(wk, sizeof wk, "%s.sections", w);
-            return fail(c, wk, "must be in 1..10000 (got %d)", obj->primitive_sections);
+            return fail(c, wk, "must be in 1..%d (got %d)", SEM_MAX_BEAM_SECTIONS,
+                        obj->primitive_sections);
         }
         if (is_torus) {
             sem_torus_def td = sem_default_torus_def();
@@ -766,6 +772,8 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
     }
     if ((st = get_int(c, root, "frames", "scene", &s->frames)) != SEM_OK) return st;
     if (s->frames < 0) return fail(c, "frames", "must be >= 0");
+    if (s->frames > SEM_MAX_FRAMES)
+        return fail(c, "frames", "%d is too large (at most %d)", s->frames, SEM_MAX_FRAMES);
     if ((st = get_int(c, root, "steps_per_frame", "scene", &s->steps_per_frame)) != SEM_OK) return st;
     if (s->steps_per_frame < 1) return fail(c, "steps_per_frame", "must be >= 1");
     if ((st = get_int(c, root, "threads", "scene", &s->world.threads)) != SEM_OK) return st;
@@ -814,18 +822,87 @@ void sem_scene_destroy(sem_scene *s)
     free(s);
 }
 
+/* Line (from 1) of position `at` in text. */
+static int line_at(const char *text, const char *at)
+{
+    int line = 1;
+    if (at)
+        for (const char *p = text; p < at && *p; ++p) line += *p == '\n';
+    return line;
+}
+
+static int compare_keys(const void *a, const void *b)
+{
+    const cJSON *x = *(const cJSON *const *)a, *y = *(const cJSON *const *)b;
+    return strcmp(x->string, y->string);
+}
+
+/* JSON allows an object to repeat a key, and cJSON keeps both while lookups see only the
+ * first: {"frames": 10, "frames": 1000} would silently run 10 frames. Every object of the
+ * document is checked (sorted keys, so a part_materials object with many names costs
+ * n log n); `where` is the path of `v` and is extended in place while descending. */
+static sem_status check_duplicate_keys(ctx *c, const cJSON *v, char *where, size_t size)
+{
+    size_t len = strlen(where);
+    if (cJSON_IsObject(v)) {
+        int n = 0;
+        for (const cJSON *it = v->child; it; it = it->next) ++n;
+        if (n > 1) {
+            const cJSON **keys = malloc((size_t)n * sizeof *keys);
+            if (!keys) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+            int k = 0;
+            for (const cJSON *it = v->child; it; it = it->next) keys[k++] = it;
+            qsort(keys, (size_t)n, sizeof *keys, compare_keys);
+            for (k = 1; k < n; ++k)
+                if (strcmp(keys[k]->string, keys[k - 1]->string) == 0) {
+                    char key[128];
+                    snprintf(key, sizeof key, "%s", keys[k]->string);
+                    free(keys);
+                    return fail(c, where, "key \"%s\" appears more than once", key);
+                }
+            free(keys);
+        }
+        for (const cJSON *it = v->child; it; it = it->next) {
+            snprintf(where + len, size - len, ".%s", it->string);
+            sem_status st = check_duplicate_keys(c, it, where, size);
+            where[len] = '\0';
+            if (st != SEM_OK) return st;
+        }
+    } else if (cJSON_IsArray(v)) {
+        int k = 0;
+        for (const cJSON *it = v->child; it; it = it->next, ++k) {
+            snprintf(where + len, size - len, "[%d]", k);
+            sem_status st = check_duplicate_keys(c, it, where, size);
+            where[len] = '\0';
+            if (st != SEM_OK) return st;
+        }
+    }
+    return SEM_OK;
+}
+
 sem_status sem_scene_parse(const char *json, const char *name, const char *base_dir,
                            sem_scene **out, sem_error *err)
 {
     *out = NULL;
     ctx c = {name, err};
-    cJSON *root = cJSON_Parse(json);
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithOpts(json, &end, 0);
     if (!root) {
         const char *e = cJSON_GetErrorPtr();
-        int line = 1;
-        if (e)
-            for (const char *p = json; p < e && *p; ++p) line += *p == '\n';
-        return sem_error_set(err, SEM_ERR_PARSE, "%s:%d: not valid JSON", name, line);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s:%d: not valid JSON", name, line_at(json, e));
+    }
+    while (end && (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r')) ++end;
+    if (end && *end) {
+        cJSON_Delete(root);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s:%d: not valid JSON: text after the end of "
+                                                 "the scene object", name, line_at(json, end));
+    }
+    char where[512];
+    snprintf(where, sizeof where, "scene");
+    sem_status dst = check_duplicate_keys(&c, root, where, sizeof where);
+    if (dst != SEM_OK) {
+        cJSON_Delete(root);
+        return dst;
     }
     sem_scene *s = calloc(1, sizeof *s);
     if (!s) {
@@ -871,23 +948,17 @@ sem_status sem_scene_parse(const char *json, const char *name, const char *base_
 sem_status sem_scene_load(const char *path, sem_scene **out, sem_error *err)
 {
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) return sem_error_set(err, SEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    if (len < 0 || len > (64L << 20)) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_IO, "%s: cannot read (or larger than 64 MiB)", path);
+    char *buf = NULL;
+    size_t got = 0;
+    sem_status rst = sem_read_file(path, SEM_MAX_SCENE_FILE_BYTES, "SEM_MAX_SCENE_FILE_BYTES", &buf,
+                                   &got, err);
+    if (rst != SEM_OK) return rst;
+    if (strlen(buf) != got) {
+        int line = line_at(buf, buf + strlen(buf));
+        free(buf);
+        return sem_error_set(err, SEM_ERR_PARSE, "%s:%d: not valid JSON: NUL byte in the file",
+                             path, line);
     }
-    char *buf = malloc((size_t)len + 1);
-    if (!buf) {
-        fclose(f);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    size_t got = fread(buf, 1, (size_t)len, f);
-    fclose(f);
-    buf[got] = '\0';
     char base[4096];
     snprintf(base, sizeof base, "%s", path);
     char *slash = strrchr(base, '/');

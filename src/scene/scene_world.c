@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "sem/cache.h"
 #include "sem/scene.h"
 
 struct sem_scene_world {
@@ -42,6 +43,7 @@ sem_scene_world_options sem_default_scene_world_options(void)
 {
     sem_scene_world_options o;
     memset(&o, 0, sizeof o);
+    o.cache_max_bytes = SEM_CACHE_DEFAULT_MAX_BYTES;
     return o;
 }
 
@@ -57,19 +59,6 @@ static void logf_(const sem_scene_world_options *o, int level, const char *fmt, 
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     o->log(o->log_user, level, msg);
-}
-
-static void make_dirs(const char *path)
-{
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; ++p)
-        if (*p == '/') {
-            *p = '\0';
-            mkdir(tmp, 0777);
-            *p = '/';
-        }
-    mkdir(tmp, 0777);
 }
 
 /* Prefixes err's message with "NAME: objects[I]SEP" (copied first: the message is both the
@@ -90,12 +79,9 @@ static sem_status preprocess_cached(const sem_model *model, const sem_preprocess
 {
     *cached = 0;
     int have_dir = o->cache_dir && o->cache_dir[0];
-    unsigned long long hash = sem_preprocess_hash(model, opt);
-    char path[4200] = "";
-    if (have_dir) snprintf(path, sizeof path, "%s/%016llx.semdisc", o->cache_dir, hash);
     if (have_dir && o->read_cache) {
         sem_error e;
-        if (sem_discretization_load(path, hash, out, &e) == SEM_OK) {
+        if (sem_cache_load(o->cache_dir, model, opt, out, &e) == SEM_OK) {
             *cached = 1;
             return SEM_OK;
         }
@@ -103,9 +89,8 @@ static sem_status preprocess_cached(const sem_model *model, const sem_preprocess
     sem_status st = sem_preprocess(model, opt, out, err);
     if (st != SEM_OK) return st;
     if (have_dir && o->write_cache) {
-        make_dirs(o->cache_dir);
         sem_error e;
-        if (sem_discretization_save(*out, path, &e) != SEM_OK)
+        if (sem_cache_store(o->cache_dir, o->cache_max_bytes, model, opt, *out, &e) != SEM_OK)
             logf_(o, 1, "cannot write the cache: %s", e.message);
     }
     return SEM_OK;

@@ -5,6 +5,15 @@
 #include <stdio.h>
 #include <string.h>
 
+/* Messages often quote the input ("parameter 3 'x' is not a number"); a file may hold any
+ * byte there. Control bytes (newlines, escape sequences that would drive the terminal) are
+ * shown as '?' so that a message stays one printable line. */
+void sem_text_sanitize(char *text)
+{
+    for (unsigned char *p = (unsigned char *)text; *p; ++p)
+        if (*p < 0x20 || *p == 0x7f) *p = '?';
+}
+
 sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...)
 {
     if (err) {
@@ -12,6 +21,7 @@ sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...
         va_start(ap, fmt);
         vsnprintf(err->message, sizeof err->message, fmt, ap);
         va_end(ap);
+        sem_text_sanitize(err->message);
         err->status = status;
     }
     return status;
