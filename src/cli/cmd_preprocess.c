@@ -132,6 +132,16 @@ int cmd_preprocess(int argc, char **argv)
             json = 1;
         } else if (strcmp(a, "--no-modes") == 0) {
             modes = 0;
+        } else if (strcmp(a, "--spacing") == 0) {
+            if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
+            rc = cli_parse_double(CMD, a, argv[++i], &o.spacing);
+            if (rc == CLI_OK && !(o.spacing > 0)) rc = cli_fail("--spacing must be > 0 (got %g)", o.spacing);
+        } else if (strcmp(a, "--origins") == 0) {
+            if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
+            const char *v = argv[++i];
+            if (strcmp(v, "coupled") == 0) o.origin_rule = SEM_ORIGINS_COUPLED;
+            else if (strcmp(v, "paper") == 0) o.origin_rule = SEM_ORIGINS_PAPER;
+            else rc = cli_fail("--origins must be coupled or paper (got '%s')", v);
         } else if (strcmp(a, "--blend") == 0) {
             if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
             rc = cli_parse_double(CMD, a, argv[++i], &blend);

@@ -179,6 +179,7 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
         cJSON_AddNumberToObject(o, "quadrature_points", sem_scene_world_discretization(r->sw, i)->n_quad);
         cJSON_AddStringToObject(o, "solver", sem_world_solver_name(r->world, i));
         cJSON_AddNumberToObject(o, "nnz_percent", sem_world_object_nnz_percent(r->world, i));
+        cJSON_AddNumberToObject(o, "spurious_modes", sem_scene_world_spurious_modes(r->sw, i));
         cJSON_AddStringToObject(o, "file_units", sem_scene_world_file_units(r->sw, i));
         cJSON_AddNumberToObject(o, "file_unit_to_meter", sem_scene_world_file_unit_to_meter(r->sw, i));
         add_render_info(r, i, o);
