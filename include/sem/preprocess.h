@@ -66,7 +66,7 @@ sem_preprocess_options sem_default_preprocess_options(void);
 
 typedef struct sem_preprocess_timings {
     double sample_s;     /* boundary sampling (Table 1's Sample) */
-    double scene_s;      /* tessellation + Embree build + orientation fix (not in Table 1) */
+    double scene_s;      /* tessellation + Embree build + orientation fix + object frame (not in Table 1) */
     double quad_s;       /* ray-cast volume quadrature (Table 1's Quad) */
     double weights_s;    /* blending weights + origins (Table 1's Weights) */
     double build_pi_s;   /* projection Pi (Table 1's Build Pi) */

@@ -423,10 +423,13 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
 
     st = sem_raycast_scene_build(model, o.tessellation, &scene, err);
     if (st != SEM_OK) goto done;
+    /* the object's frame (principal axes of the surface) belongs to the shared setup: the
+     * quadrature cells and the default alpha and gamma lengths are measured in it */
+    st = sem_step_frame(scene, d, err);
+    if (st != SEM_OK) goto done;
     double t1b = omp_get_wtime();
     d->timings.scene_s = t1b - t1;
-    st = sem_step_frame(scene, d, err);
-    if (st == SEM_OK) st = sem_step_quadrature(model, scene, &o, d, err);
+    st = sem_step_quadrature(model, scene, &o, d, err);
     if (st != SEM_OK) goto done;
     double t2 = omp_get_wtime();
     d->timings.quad_s = t2 - t1b;
