@@ -99,9 +99,8 @@ static void test_all_shared_models_load(void)
     CHECK(n_loaded >= 60, "only %d IGES files found under %s", n_loaded, dir);
     printf("loaded %d IGES files; slowest %.4f s (%s)\n", n_loaded, slowest, slowest_name);
     /* Release loads the largest file in < 0.01 s and castle.iges, whose 28 boundaries are
-     * projected from model space, in about 0.05 s; a sanitized build's times mean nothing */
-    if (!getenv("SEM_SANITIZED"))
-        CHECK(slowest < 0.25, "slowest load %.3f s (%s)", slowest, slowest_name);
+     * projected from model space, in about 0.05 s (printed, not asserted: speed goals live in
+     * benchmarks, and a loaded machine's wall clock says nothing about the code) */
 }
 
 /* q = 3 x control points equals the paper's Table 1 */
