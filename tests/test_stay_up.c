@@ -16,6 +16,7 @@
 
 #include "sem/measure.h"
 #include "sem/model.h"
+#include "sem/preprocess.h"
 #include "sem/scene.h"
 #include "sem/simulation.h"
 #include "test_util.h"
@@ -83,8 +84,52 @@ static void stay_up(const char *relative)
     sem_scene_destroy(scene);
 }
 
+static void collect_log(void *user, int level, const char *message)
+{
+    if (level < 1) return;
+    char *buf = user;
+    size_t n = strlen(buf);
+    snprintf(buf + n, 4096 - n, "%s\n", message);
+}
+
+/* A part too small for the default quadrature is named, and a finer spacing gives it its own
+ * volume: the mug's 9 cm^2 part 0 (of 323 cm^2). */
+static void small_part_named(void)
+{
+    const char *path = test_shared_model("mugs/mug.iges");
+    if (!path) return;
+    for (int fine = 0; fine < 2; ++fine) {
+        char json[4600], log[4096] = "";
+        snprintf(json, sizeof json, "{\"objects\": [{\"model\": \"%s\"%s}], \"frames\": 1}", path,
+                 fine ? ", \"sem\": {\"spacing\": 0.004}" : "");
+        sem_error err;
+        sem_scene *scene = NULL;
+        sem_scene_world *sw = NULL;
+        sem_scene_world_options o = sem_default_scene_world_options();
+        o.log = collect_log;
+        o.log_user = log;
+        if (sem_scene_parse(json, "mug", "/", &scene, &err) != SEM_OK ||
+            sem_scene_world_create(scene, &o, &sw, &err) != SEM_OK) {
+            CHECK(0, "mug: %s", err.message);
+        } else {
+            const sem_discretization *d = sem_scene_world_discretization(sw, 0);
+            printf("mug, %s spacing: part 0 %s\n", fine ? "4 mm" : "default",
+                   d->part_covered && d->part_covered[0] ? "has no volume of its own" : "has its own volume");
+            if (!fine)
+                CHECK(d->part_covered && d->part_covered[0] && strstr(log, "part 0 (Body12) is too small or thin"),
+                      "the default quadrature misses part 0 and says so: %s", log);
+            else
+                CHECK(d->part_covered && !d->part_covered[0] && !strstr(log, "too small or thin"),
+                      "a 4 mm spacing gives part 0 its own volume: %s", log);
+        }
+        sem_scene_world_destroy(sw);
+        sem_scene_destroy(scene);
+    }
+}
+
 int main(void)
 {
+    small_part_named();
     if (!getenv("SEM_SANITIZED")) {
         /* the rocket's fins (once fell off its body), the tire's nested shells, the trimmed
          * mug's handle, the landing starship's legs, the puft's arms */

@@ -111,6 +111,9 @@ typedef struct sem_discretization {
     int n_origins;
     double *origin_X;      /* 3 per origin (rest) */
     int *part_origin;      /* origin of each part */
+    int *part_covered;     /* per part: 1 when no quadrature point lay in its solid (too small
+                              or thin for the quadrature): it has no volume of its own and is
+                              blended into the points nearest it (weights_cover.c) */
 
     /* projection (Eq. 7): n_parts * n_basis rows x n_ctrl */
     sem_csr Pi;

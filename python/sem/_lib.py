@@ -198,7 +198,7 @@ class sem_discretization(Structure):
                 ("volume", c_double),
                 ("alpha", c_double), ("W", sem_csr), ("W_samples", sem_csr),
                 ("n_origins", c_int), ("origin_X", POINTER(c_double)),
-                ("part_origin", POINTER(c_int)),
+                ("part_origin", POINTER(c_int)), ("part_covered", POINTER(c_int)),
                 ("Pi", sem_csr),
                 ("Gamma", sem_csr), ("Grad", sem_csr), ("Gamma_samples", sem_csr),
                 ("M", sem_csr), ("M_eps", sem_csr), ("gamma", c_double),

@@ -47,6 +47,9 @@ static cJSON *to_json(const sem_discretization *d, double total_s)
     cJSON_AddNumberToObject(j, "boundary_samples", d->n_samples);
     cJSON_AddNumberToObject(j, "gamma", d->gamma);
     cJSON_AddNumberToObject(j, "length_scale", d->length_scale);
+    cJSON *cov = cJSON_AddArrayToObject(j, "parts_without_volume");
+    for (int i = 0; d->part_covered && i < d->n_parts; ++i)
+        if (d->part_covered[i]) cJSON_AddItemToArray(cov, cJSON_CreateNumber(i));
     char hash[32];
     snprintf(hash, sizeof hash, "%016llx", d->model_hash);
     cJSON_AddStringToObject(j, "hash", hash);

@@ -44,7 +44,7 @@
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
 
-#define SEM_DISC_FORMAT_VERSION 3u
+#define SEM_DISC_FORMAT_VERSION 4u
 #define SEM_DISC_BYTE_ORDER 0x01020304u
 static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
 
@@ -251,6 +251,7 @@ void sem_discretization_destroy(sem_discretization *d)
     free(d->quad_X);
     free(d->quad_volume);
     free(d->quad_part);
+    free(d->part_covered);
     sem_csr_free(&d->W);
     sem_csr_free(&d->W_samples);
     free(d->origin_X);
@@ -589,6 +590,13 @@ sem_status sem_discretization_save(const sem_discretization *d, const char *path
     w_csr(&w, &d->W_samples);
     w_doubles(&w, d->origin_X, d->origin_X ? 3 * (size_t)d->n_origins : 0);
     w_ints(&w, d->part_origin, d->part_origin ? (size_t)d->n_parts : 0);
+    if (d->part_covered) {
+        w_ints(&w, d->part_covered, (size_t)d->n_parts);
+    } else { /* always n_parts entries: zeros when no part needed covering */
+        const int zero = 0;
+        w_u64(&w, (uint64_t)d->n_parts);
+        for (int i = 0; i < d->n_parts; ++i) w_bytes(&w, &zero, sizeof zero);
+    }
     w_csr(&w, &d->Pi);
     w_csr(&w, &d->Gamma);
     w_csr(&w, &d->Grad);
@@ -894,6 +902,7 @@ sem_status sem_discretization_load_buffer(const char *name, const void *bytes, s
         r_csr(&r, &d->W_samples, d->n_samples, d->n_parts, "W_samples");
         d->origin_X = r_doubles(&r, 3 * (size_t)d->n_origins, "origin_X");
         d->part_origin = r_ints(&r, P, "part_origin");
+        d->part_covered = r_ints(&r, P, "part_covered");
         r_csr(&r, &d->Pi, d->n_parts * d->n_basis, d->n_ctrl, "Pi");
         r_csr(&r, &d->Gamma, d->n_quad, d->n_ctrl, "Gamma");
         r_csr(&r, &d->Grad, 3 * d->n_quad, d->n_ctrl, "Grad");

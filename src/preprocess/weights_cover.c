@@ -32,6 +32,13 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
         if (d->W.val[e] > 0) seen[d->W.col[e]] = 1;
     int missing = 0;
     for (int i = 0; i < np; ++i) missing += !seen[i];
+    free(d->part_covered);
+    d->part_covered = calloc((size_t)np, sizeof *d->part_covered);
+    if (!d->part_covered) {
+        free(seen);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int i = 0; i < np; ++i) d->part_covered[i] = !seen[i];
     if (missing == 0) {
         free(seen);
         return SEM_OK;

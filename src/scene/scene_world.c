@@ -191,6 +191,14 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     logf_(o, 0, "object %d: %s: %d quadrature points, volume %.6g", i,
           cached ? "preprocessed data reused from the cache" : "preprocessed", sw->discs[i]->n_quad,
           sw->discs[i]->volume);
+    const sem_discretization *d = sw->discs[i];
+    for (int k = 0; d->part_covered && k < d->n_parts; ++k)
+        if (d->part_covered[k])
+            logf_(o, 1,
+                  "objects[%d]: part %d%s%s%s is too small or thin for the volume quadrature: it has no volume "
+                  "of its own and moves with the points nearest it (a smaller sem.spacing gives it its own)",
+                  i, k, model->parts[k].name[0] ? " (" : "", model->parts[k].name,
+                  model->parts[k].name[0] ? ")" : "");
 
     if ((st = sem_scene_object_pins(so, model, &sw->pins[i], err)) != SEM_OK ||
         (st = sem_scene_object_part_materials(so, model, &sw->part_material[i], &sw->materials[i],
