@@ -10,7 +10,7 @@
  *   model.h       NURBS models (parts, trims) and files (IGES, OBJ free-form, STEP)
  *   nurbs.h       B-spline / NURBS evaluation          trim.h      trimmed domains
  *   tessellate.h  triangle meshes                      measure.h   area, bounding box
- *   primitives.h  exact NURBS solids built in code
+ *   primitives.h  exact NURBS solids built in code    refine.h    exact knot refinement
  *   sparse.h      compressed sparse rows (the preprocessing data)
  *   preprocess.h  model -> SEM discretization (paper Sec. 5-7, Alg. 1)
  *   cache.h       a bounded folder of discretizations keyed by model and settings
@@ -35,6 +35,7 @@
 #include "sem/tessellate.h"
 #include "sem/measure.h"
 #include "sem/primitives.h"
+#include "sem/refine.h"
 #include "sem/sparse.h"
 #include "sem/preprocess.h"
 #include "sem/cache.h"

@@ -47,6 +47,14 @@ static const cli_command commands[] = {
     {"convert", cmd_convert, "IN OUT", "convert a model between formats (by extension)",
      "  IN and OUT: .igs/.iges (IGES 5.3), .obj (OBJ free-form), .step/.stp (STEP, through\n"
      "  Open CASCADE; `sem --version` says when this build has no STEP support)\n"},
+    {"refine", cmd_refine, "IN OUT --factor K",
+     "the same model with more control points: exact knot insertion (about K^2 times per part)",
+     "  --factor K, -k K  split every non-empty knot span of every part into K equal parts in u\n"
+     "                    and in v (1..64); a direction with n control points and s spans gets\n"
+     "                    n + (K - 1) s. The surfaces are unchanged up to round-off (rational\n"
+     "                    ones too); trims, part names and units are kept.\n"
+     "  IN and OUT: any model format (by extension, as sem convert). The result is refused when\n"
+     "  it would exceed what the readers accept (include/sem/limits.h).\n"},
     {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--spacing H | --rays N1 N2 [--axis x|y|z]] [--points-per-interval N] [--alpha A | --sparsity T] [--origins coupled|paper] [--gamma G] [-E E] [--blend C] [--tessellation N] [--threads N] [--json] [--save OUT] [--no-cache] [--no-modes]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings and zero-energy modes", "  --order 1|2 (2)  --spacing H quadrature cell size (automatic: object-frame cells)\n  --rays N1 N2 the paper's explicit ray grid along --axis (x)  --points-per-interval N (automatic)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --origins coupled|paper (coupled)  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)\n  --blend C volume consistency stiffness for the mode check (0.02)  --no-modes skip the zero-energy mode check\n  --tessellation N (16)  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n  The result goes into the cache sem run reads ($SEM_CACHE_DIR, see sem run --help) unless --no-cache.\n"},
     {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--overwrite] [--json] [--no-cache] [--quiet] | --resume DIR",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
