@@ -100,7 +100,16 @@ sem_status sem_world_object_modes(sem_world *w, int object, sem_object_modes *ou
     c.s = s;
     double sigma = 1e-3 * lref;
     sem_system_fill(s, sigma, 1.0, 0, 1.0);
-    if ((st = sem_system_factorize(s, err)) != SEM_OK) goto done;
+    if ((st = sem_system_factorize(s, err)) != SEM_OK) {
+        /* K + sigma M is singular: motions with neither mass nor stiffness */
+        if (st == SEM_ERR_NUMERIC)
+            sem_error_set(err, st,
+                          "some motions have neither mass nor stiffness (%d quadrature points for %d control "
+                          "points, volume %.3g): the surfaces enclose too little volume (open surfaces?) or the "
+                          "quadrature is too coarse (a smaller sem.spacing)",
+                          o->n_quad, o->n_ctrl, o->volume);
+        goto done;
+    }
 
     /* the rigid motions of the control points, about their mean */
     double cen[3] = {0, 0, 0};

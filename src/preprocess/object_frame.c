@@ -315,7 +315,7 @@ sem_status sem_part_sizes(const sem_discretization *d, double *size, double *med
         if (size) size[i] = s;
         if (s > 0) sorted[n++] = s;
     }
-    qsort(sorted, (size_t)n, sizeof *sorted, double_cmp);
+    if (n > 0) qsort(sorted, (size_t)n, sizeof *sorted, double_cmp);
     if (median) *median = n > 0 ? sorted[n / 2] : 0.0;
     free(box);
     free(sorted);

@@ -157,7 +157,7 @@ static long long part_couplings(const sem_discretization *d, pair_coupling **out
                 pc[k++] = (pair_coupling){W->col[i], W->col[j], v * W->val[i] * W->val[j]};
         }
     }
-    qsort(pc, k, sizeof *pc, pair_cmp);
+    if (k > 0) qsort(pc, k, sizeof *pc, pair_cmp);
     size_t m = 0;
     for (size_t i = 0; i < k; ++i) {
         if (m > 0 && pc[m - 1].a == pc[i].a && pc[m - 1].b == pc[i].b)
@@ -216,7 +216,7 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
                 gpc[ng++] = (pair_coupling){a < b ? a : b, a < b ? b : a, pc[k].c};
             }
         }
-        qsort(gpc, (size_t)ng, sizeof *gpc, pair_cmp);
+        if (ng > 0) qsort(gpc, (size_t)ng, sizeof *gpc, pair_cmp);
         for (int i = 0; i < np; ++i) join[i] = i;
         int merged = 0;
         long long m = 0;

@@ -245,7 +245,7 @@ static int column(const sem_raycast_scene *scene, const cell_grid *g, int i, int
             free(seg);
         }
     /* each cell's material: the part with the longest inside length (entries summed) */
-    qsort(b->entries, (size_t)b->n_entries, sizeof *b->entries, entry_cmp);
+    if (b->n_entries > 0) qsort(b->entries, (size_t)b->n_entries, sizeof *b->entries, entry_cmp);
     int cap = 0, e = 0;
     for (int k = 0; k < n0; ++k) {
         const double cell_volume = h0 * g->h[1] * g->h[2] / (double)(1 << (3 * lev[k]));
