@@ -38,6 +38,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "union_find.h"
 
 /* A group whose samples' second-moment eigenvalues have a smaller/larger ratio than this is
  * flat (its thinnest extent is under ~10 % of its largest). */
@@ -55,22 +56,6 @@ static int pair_cmp(const void *x, const void *y)
     const pair_coupling *p = x, *q = y;
     if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
     return (p->b > q->b) - (p->b < q->b);
-}
-
-static int find_root(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void unite(int *parent, int a, int b)
-{
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[a > b ? a : b] = a < b ? a : b; /* the smaller index is the root */
 }
 
 /* Smallest / largest eigenvalue of a symmetric 3x3 (xx yy zz xy xz yz), closed form. */
@@ -95,7 +80,7 @@ static void group_moments(const sem_discretization *d, int *parent, double *mom)
 {
     memset(mom, 0, 10 * (size_t)d->n_parts * sizeof *mom);
     for (int k = 0; k < d->n_samples; ++k) {
-        double *m = mom + 10 * (size_t)find_root(parent, d->sample_part[k]);
+        double *m = mom + 10 * (size_t)sem_uf_find(parent, d->sample_part[k]);
         double a = d->sample_area[k] > 0 ? d->sample_area[k] : 0.0;
         const double *X = d->sample_X + 3 * (size_t)k;
         m[0] += a;
@@ -198,7 +183,7 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
         int n_groups = 0, n_unsettled = 0;
         for (int i = 0; i < np; ++i) {
             settled[i] = 1;
-            if (find_root(parent, i) != i) continue;
+            if (sem_uf_find(parent, i) != i) continue;
             n_groups++;
             settled[i] = group_ratio(mom + 10 * (size_t)i) >= FLAT_RATIO;
             n_unsettled += !settled[i];
@@ -206,10 +191,10 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
         if (n_unsettled == 0 || n_groups <= 1) break;
         /* group couplings: self (c(C, C)) and between groups (pairs merged again) */
         memset(gself, 0, (size_t)np * sizeof *gself);
-        for (int i = 0; i < np; ++i) gself[find_root(parent, i)] += self[i];
+        for (int i = 0; i < np; ++i) gself[sem_uf_find(parent, i)] += self[i];
         long long ng = 0;
         for (long long k = 0; k < n_pairs; ++k) {
-            int a = find_root(parent, pc[k].a), b = find_root(parent, pc[k].b);
+            int a = sem_uf_find(parent, pc[k].a), b = sem_uf_find(parent, pc[k].b);
             if (a == b) {
                 gself[a] += 2 * pc[k].c;
             } else {
@@ -250,19 +235,19 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
                     if (pass == 0) {
                         best[a] = fmax(best[a], s);
                     } else if (best[a] > 0 && s >= best[a] * (1 - TIE)) {
-                        unite(join, a, b);
+                        sem_uf_unite(join, a, b);
                         merged = 1;
                     }
                 }
             }
         /* an unsettled group coupled to nothing joins the nearest group (centroids) */
         for (int i = 0; i < np; ++i) {
-            if (settled[i] || best[i] > 0 || find_root(parent, i) != i) continue;
+            if (settled[i] || best[i] > 0 || sem_uf_find(parent, i) != i) continue;
             const double *mi = mom + 10 * (size_t)i;
             double bd = INFINITY;
             int bj = -1;
             for (int j = 0; j < np; ++j) {
-                if (j == i || find_root(parent, j) != j) continue;
+                if (j == i || sem_uf_find(parent, j) != j) continue;
                 const double *mj = mom + 10 * (size_t)j;
                 if (!(mi[0] > 0) || !(mj[0] > 0)) continue;
                 double dd = 0;
@@ -276,12 +261,12 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
                 }
             }
             if (bj >= 0) {
-                unite(join, i, bj);
+                sem_uf_unite(join, i, bj);
                 merged = 1;
             }
         }
         if (!merged) break;
-        for (int i = 0; i < np; ++i) unite(parent, i, find_root(join, find_root(parent, i)));
+        for (int i = 0; i < np; ++i) sem_uf_unite(parent, i, sem_uf_find(join, sem_uf_find(parent, i)));
     }
 
     /* origins: groups numbered by their smallest part, at their samples' centroid */
@@ -296,7 +281,7 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
         }
         for (int i = 0; i < np; ++i) root_origin[i] = -1;
         for (int i = 0; i < np; ++i) {
-            int r = find_root(parent, i);
+            int r = sem_uf_find(parent, i);
             if (root_origin[r] < 0) root_origin[r] = n_origins++;
             part_origin[i] = root_origin[r];
         }
@@ -308,7 +293,7 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
             goto nomem;
         }
         for (int i = 0; i < np; ++i) {
-            if (find_root(parent, i) != i) continue;
+            if (sem_uf_find(parent, i) != i) continue;
             const double *mi = mom + 10 * (size_t)i;
             double *x = X + 3 * (size_t)root_origin[i];
             if (mi[0] > 0)

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "union_find.h"
 
 /* A boundary sample couples two origins when both carry at least this weight there. */
 #define TIE_WEIGHT 0.05
@@ -34,22 +35,6 @@ typedef struct origin_pair {
     int a, b;   /* origins, a < b */
     double c;   /* sum over quadrature points of vol w_a w_b (parts summed per origin) */
 } origin_pair;
-
-static int find_root(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void unite(int *parent, int a, int b)
-{
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[a > b ? a : b] = a < b ? a : b;
-}
 
 static int pair_by_index(const void *x, const void *y)
 {
@@ -90,7 +75,7 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
             if (first < 0)
                 first = o;
             else
-                unite(comp, first, o);
+                sem_uf_unite(comp, first, o);
         }
     }
     /* origin pairs blended at quadrature points, across components */
@@ -103,7 +88,7 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
             int oi = d->part_origin[W->col[i]];
             for (int k = i + 1; k < b1; ++k) {
                 int ok = d->part_origin[W->col[k]];
-                if (oi == ok || find_root(comp, oi) == find_root(comp, ok)) continue;
+                if (oi == ok || sem_uf_find(comp, oi) == sem_uf_find(comp, ok)) continue;
                 if (n_pairs == cap) {
                     size_t nc = cap ? 2 * cap : 256;
                     origin_pair *g = realloc(pairs, nc * sizeof *g);
@@ -129,10 +114,10 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
         qsort(pairs, m, sizeof *pairs, pair_by_strength);
         int ties = 0;
         for (size_t k = 0; k < m; ++k) {
-            int ca = find_root(comp, pairs[k].a), cb = find_root(comp, pairs[k].b);
+            int ca = sem_uf_find(comp, pairs[k].a), cb = sem_uf_find(comp, pairs[k].b);
             if (ca == cb) continue;
-            unite(comp, ca, cb);
-            unite(merge, pairs[k].a, pairs[k].b);
+            sem_uf_unite(comp, ca, cb);
+            sem_uf_unite(merge, pairs[k].a, pairs[k].b);
             ties++;
         }
         if (n_ties) *n_ties = ties;
@@ -145,7 +130,7 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
         int *part_origin = malloc((size_t)np * sizeof *part_origin);
         if (!part_origin) goto nomem;
         for (int i = 0; i < np; ++i) {
-            int r = find_root(merge, d->part_origin[i]);
+            int r = sem_uf_find(merge, d->part_origin[i]);
             if (seen[r] < 0) seen[r] = n_new++;
             part_origin[i] = seen[r];
         }

@@ -64,6 +64,7 @@
  * - Orientation votes stop as soon as the votes not cast yet cannot change the sign.
  */
 #include "raycast.h"
+#include "union_find.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -1201,15 +1202,6 @@ static int estimate_part_sign(const sem_raycast_scene *s, const int *component, 
     return vote >= 0 ? 1 : -1;
 }
 
-static int find_root(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
 /* Boundary vertices of each part (vertices of edges used by one triangle only), up to
  * COMPONENT_SAMPLES per part spread along the list: 3 doubles each into samples
  * (n_parts * COMPONENT_SAMPLES * 3), counts into n_samples. Returns 0 when out of memory. */
@@ -1326,11 +1318,10 @@ static int part_components(const sem_raycast_scene *s, const double *samples,
             const double *X = samples + 3 * ((size_t)p * COMPONENT_SAMPLES + (size_t)k);
             int n = closest_parts_embree(s, X, tol, found, dist, NULL);
             for (int i = 0; i < n; i++) {
-                int a = find_root(parent, p), b = find_root(parent, found[i]);
-                if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+                sem_uf_unite(parent, p, found[i]);
             }
         }
-    for (int p = 0; p < n_parts; p++) component[p] = find_root(parent, p);
+    for (int p = 0; p < n_parts; p++) component[p] = sem_uf_find(parent, p);
     free(parent);
     free(found);
     free(dist);
