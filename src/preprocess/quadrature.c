@@ -63,8 +63,7 @@
 #define MAX_POINTS_ALONG 100000
 
 
-/* Appends one point to a ray's result (geometric growth). Returns 0 on out of memory. */
-static int push_point(sem_ray_points *r, int *cap, const double X[3], double volume, int part)
+int sem_ray_points_push(sem_ray_points *r, int *cap, const double X[3], double volume, int part)
 {
     if (r->n == *cap) {
         int c = *cap ? 2 * *cap : 16;
@@ -230,7 +229,7 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
                 double t = a + (k + 0.5) * h, X[3];
                 while (s < j && seg[s].t1 <= t) s++;
                 for (int d = 0; d < 3; d++) X[d] = origin[d] + t * dir[d];
-                if (!push_point(result, &cap, X, h * cell_area, seg[s].part)) {
+                if (!sem_ray_points_push(result, &cap, X, h * cell_area, seg[s].part)) {
                     ok = 0;
                     break;
                 }

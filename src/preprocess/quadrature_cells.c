@@ -99,28 +99,6 @@ static int push_entry(column_buffers *b, int cell, int part, double len)
     return 1;
 }
 
-static int push_point(sem_ray_points *r, int *cap, const double X[3], double volume, int part)
-{
-    if (r->n == *cap) {
-        int c = *cap ? 2 * *cap : 16;
-        double *nx = realloc(r->X, (size_t)c * 3 * sizeof *nx);
-        if (!nx) return 0;
-        r->X = nx;
-        double *nv = realloc(r->volume, (size_t)c * sizeof *nv);
-        if (!nv) return 0;
-        r->volume = nv;
-        int *np = realloc(r->part, (size_t)c * sizeof *np);
-        if (!np) return 0;
-        r->part = np;
-        *cap = c;
-    }
-    memcpy(r->X + 3 * (size_t)r->n, X, 3 * sizeof *X);
-    r->volume[r->n] = volume;
-    r->part[r->n] = part;
-    r->n++;
-    return 1;
-}
-
 /* The point(s) of one cell: its inside volume's centroid, or, where that volume is thin along
  * principal directions (a wall, a fin, a rod narrower than ~0.7 cells: standard deviation below
  * THIN_STD of the cell size h), two points across each thin direction at centroid +- one
@@ -159,7 +137,7 @@ static int emit_cell(const column_buffers *b, int cell, const double col_origin[
             for (int e = 0; e < 3; ++e) X[e] += sgn * sd * C[3 * e + a]; /* column a: eigenvector */
         }
         for (int e = 0; e < 3; ++e) X[e] += col_origin[e];
-        if (!push_point(result, cap, X, V / n_points, part)) return 0;
+        if (!sem_ray_points_push(result, cap, X, V / n_points, part)) return 0;
     }
     return 1;
 }

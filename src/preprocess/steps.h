@@ -42,6 +42,10 @@ typedef struct sem_ray_points {
     int *part;
 } sem_ray_points;
 
+/* quadrature.c: appends one point (geometric growth; *cap is the arrays' capacity). Returns 0
+ * when out of memory. */
+int sem_ray_points_push(sem_ray_points *r, int *cap, const double X[3], double volume, int part);
+
 /* A piece of a ray between two hits: inside the solid or not, and the part whose material it
  * takes (the innermost entered component's entering part). */
 typedef struct sem_ray_segment {
