@@ -30,7 +30,8 @@ typedef enum sem_integrator {
 typedef enum sem_solver_choice {
     SEM_SOLVER_AUTO,   /* a fixed rule: dense up to 500 dofs, CHOLMOD above (reproducible) */
     SEM_SOLVER_SPARSE, /* CHOLMOD */
-    SEM_SOLVER_DENSE   /* LAPACK dpotrf */
+    SEM_SOLVER_DENSE,  /* LAPACK dpotrf */
+    SEM_SOLVER_STRUCTURED /* part-sparse plus low rank through Pi (Woodbury); no q-space matrix */
 } sem_solver_choice;
 
 /* Messages of a world: level 0 information (Newton's trace, when asked for), 1 warning. */

@@ -159,6 +159,7 @@ int cmd_bench(int argc, char **argv)
             if (strcmp(v, "auto") == 0) solver = SEM_SOLVER_AUTO;
             else if (strcmp(v, "sparse") == 0) solver = SEM_SOLVER_SPARSE;
             else if (strcmp(v, "dense") == 0) solver = SEM_SOLVER_DENSE;
+            else if (strcmp(v, "structured") == 0) solver = SEM_SOLVER_STRUCTURED;
             else return cli_usage(CMD, "--solver must be auto, sparse or dense (got '%s')", v);
         } else if (argv[i][0] == '-') return cli_usage(CMD, "unknown option '%s'", argv[i]);
         else return cli_usage(CMD, "unexpected argument '%s'", argv[i]);

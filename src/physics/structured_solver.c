@@ -1,0 +1,757 @@
+/*
+ * structured_solver.c - the system of one object's free dofs solved through its structure:
+ * Woodbury on c S0 + V^T Mid V with a small dense capacitance matrix, refined by conjugate
+ * gradients on the exact products (the design is in structured.h).
+ *
+ * Reduced rows. Row i m + 0 of Pi is the translation t_j of part i's origin, the same for
+ * every part of the group (projection.c), so P has repeated rows. Only P's row space enters
+ * A, so the rows are reduced: P = E P~ with P~ the distinct rows and E the 0/1 expansion;
+ * then A = c S0 + P~^T Z~ P~ - c (P~^T G~ + G~^T P~) with Z~ = E^T Z E and G~ = E^T G (the
+ * duplicates' rows summed). r = rows of P~ per coordinate.
+ *
+ * Schur complement. With B = F2 - I, the capacitance (times c) is [[F1, B], [B^T, F3 - Z~/c]].
+ * F1 = P~ S0^-1 P~^T is constant and positive definite once the rows are distinct, so it is
+ * eliminated once: what is left to factorize at each step is
+ *
+ *   H = Z~/c - (F3 - B^T F1^-1 B)        (3 r square; the constant part is precomputed)
+ *
+ * and A is positive definite exactly when H is (inertia: In(Cap) = In(F1) + In(-H), and A > 0
+ * iff Cap has 3r negative eigenvalues), so H's Cholesky factorization is the test the
+ * q-space Cholesky solvers make. Should F1 not be positive definite (rows of P dependent
+ * beyond the repeated translations), the whole 6 r capacitance is factorized instead
+ * (LDL^T, Bunch-Kaufman) and its inertia counted.
+ *
+ * Layout. Free control points f = 0..n-1 (o->free_index); dofs 3 f + d. Coefficient
+ * vectors: reduced row rho, coordinate d at 3 rho + d (P~ rows; G~ rows likewise in a second
+ * vector). The scalar matrices (S0, V, F) are the same for each coordinate; only Z couples
+ * coordinates.
+ *
+ * Cost per factorization: forming H (the Kz pair blocks to the parts' own bases) and its
+ * Cholesky factorization, (3r)^3 / 3 flops. Per solve: two sparse solves with S0 (3
+ * right-hand sides), products with V and V^T, small dense solves, then one or two conjugate
+ * gradient iterations whose products cost O(nnz Pi + samples). Every sum runs in a fixed
+ * order, and OpenBLAS uses a fixed thread count (as linear_solver.c), so the bits do not
+ * depend on the thread count.
+ */
+#include "structured.h"
+
+#include <cblas.h>
+#include <lapacke.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <suitesparse/cholmod.h>
+
+/* The fixed OpenBLAS thread count of linear_solver.c (see there). */
+#define BLAS_THREADS 2
+/* Columns of V^T solved with S0 at a time while forming F. */
+#define F_CHUNK 128
+/* Conjugate gradient refinement: stop at this relative residual; a solve that cannot reach
+ * CG_FAIL within CG_MAX_ITERATIONS is an error, not a quiet wrong answer. */
+#define CG_TOLERANCE 1e-12
+#define CG_FAIL 1e-7
+#define CG_MAX_ITERATIONS 60
+
+struct sem_structured_solver {
+    sem_object *o;
+    int n;          /* free control points */
+    int r0, r;      /* coefficient rows per coordinate: all, distinct */
+    int *red;       /* r0: reduced row of each row of P */
+    int *p_first;   /* r: a row of P for each reduced row */
+    cholmod_common common;
+    cholmod_factor *L; /* S0 */
+    /* V = [P~; G~] (2 r x n) over the free control points, CSR, and its transpose */
+    int *v_start, *v_col;
+    double *v_val;
+    int *vt_start, *vt_row;
+    double *vt_val;
+    double *F;      /* 2r x 2r, row-major: V S0^-1 V^T */
+    int schur;      /* 1: F1 eliminated (H), 0: the whole capacitance (fallback) */
+    double *F1;     /* r x r column-major Cholesky factor of F1 */
+    double *Y;      /* r x r row-major: F1^-1 B */
+    double *Hc;     /* r x r row-major: F3 - B^T F1^-1 B */
+    double *C;      /* schur: H (3r square); else the 6r capacitance; column-major, factored */
+    lapack_int *ipiv;
+    double coef[4];
+    double last_factor_s;
+    double *work;
+};
+
+void sem_structured_solver_destroy(sem_structured_solver *s)
+{
+    if (!s) return;
+    if (s->L) cholmod_free_factor(&s->L, &s->common);
+    cholmod_finish(&s->common);
+    free(s->red);
+    free(s->p_first);
+    free(s->v_start);
+    free(s->v_col);
+    free(s->v_val);
+    free(s->vt_start);
+    free(s->vt_row);
+    free(s->vt_val);
+    free(s->F);
+    free(s->F1);
+    free(s->Y);
+    free(s->Hc);
+    free(s->C);
+    free(s->ipiv);
+    free(s->work);
+    free(s);
+}
+
+/* The distinct rows of P: a part's translation row equal (bit for bit) to an earlier part's
+ * of the same group is that row. */
+static sem_status reduce_rows(sem_structured_solver *s, sem_error *err)
+{
+    const sem_object *o = s->o;
+    const sem_structured_ops *ops = o->ops;
+    int m = o->m;
+    s->red = malloc(((size_t)s->r0 + 1) * sizeof(int));
+    s->p_first = malloc(((size_t)s->r0 + 1) * sizeof(int));
+    if (!s->red || !s->p_first) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    s->r = 0;
+    for (int i = 0; i < o->n_parts; ++i)
+        for (int k = 0; k < m; ++k) {
+            int row = i * m + k, same = -1;
+            if (k == 0)
+                for (int j = 0; j < i && same < 0; ++j) {
+                    if (o->d->part_origin[j] != o->d->part_origin[i]) continue;
+                    int a = ops->p_start[row], b = ops->p_start[j * m];
+                    size_t len = (size_t)(ops->p_start[row + 1] - a);
+                    if (len == (size_t)(ops->p_start[j * m + 1] - b) &&
+                        memcmp(ops->p_val + a, ops->p_val + b, len * sizeof(double)) == 0)
+                        same = s->red[j * m];
+                }
+            if (same >= 0) {
+                s->red[row] = same;
+            } else {
+                s->p_first[s->r] = row;
+                s->red[row] = s->r++;
+            }
+        }
+    return SEM_OK;
+}
+
+/* S0 = sum_s a_s J_s^T J_s over the free control points, factorized. */
+static sem_status factor_S0(sem_structured_solver *s, sem_error *err)
+{
+    const sem_object *o = s->o;
+    const sem_structured_ops *ops = o->ops;
+    size_t nt = 0;
+    for (int r = 0; r < ops->n_rows; ++r) {
+        size_t k = (size_t)(ops->j_start[r + 1] - ops->j_start[r]);
+        nt += k * (k + 1) / 2;
+    }
+    cholmod_triplet *T = cholmod_allocate_triplet((size_t)s->n, (size_t)s->n, nt + 1, -1, CHOLMOD_REAL, &s->common);
+    if (!T) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the sample matrix");
+    int *ti = T->i, *tj = T->j;
+    double *tx = T->x;
+    size_t k = 0;
+    for (int r = 0; r < ops->n_rows; ++r)
+        for (int a = ops->j_start[r]; a < ops->j_start[r + 1]; ++a) {
+            int fa = o->free_index[ops->j_col[a]];
+            if (fa < 0) continue;
+            for (int b = a; b < ops->j_start[r + 1]; ++b) {
+                int fb = o->free_index[ops->j_col[b]];
+                if (fb < 0) continue;
+                ti[k] = fa > fb ? fa : fb;
+                tj[k] = fa > fb ? fb : fa;
+                tx[k++] = ops->area[r] * ops->j_val[a] * ops->j_val[b];
+            }
+        }
+    T->nnz = k;
+    cholmod_sparse *S0 = cholmod_triplet_to_sparse(T, k, &s->common);
+    cholmod_free_triplet(&T, &s->common);
+    if (!S0) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the sample matrix");
+    s->L = cholmod_analyze(S0, &s->common);
+    int ok = s->L && cholmod_factorize(S0, s->L, &s->common) && s->common.status == CHOLMOD_OK;
+    cholmod_free_sparse(&S0, &s->common);
+    if (!s->L) return sem_error_set(err, SEM_ERR_NOMEM, "CHOLMOD analysis of the sample matrix failed");
+    if (!ok)
+        return sem_error_set(err, SEM_ERR_NUMERIC,
+                             "a free control point is seen by no boundary sample (sample matrix "
+                             "singular, CHOLMOD status %d)",
+                             s->common.status);
+    return SEM_OK;
+}
+
+/* V = [P~; G~] over the free control points (the reduced rows of P; G = sum_s a_s g_s^T J_s
+ * with the rows of duplicates summed, G~ = E^T G); and V^T. */
+static sem_status build_V(sem_structured_solver *s, sem_error *err)
+{
+    const sem_object *o = s->o;
+    const sem_structured_ops *ops = o->ops;
+    int r0 = s->r, n = s->n, nr = ops->n_rows;
+    /* samples per reduced coefficient row (transpose of g) */
+    int *gt_start = calloc((size_t)r0 + 1, sizeof(int));
+    if (!gt_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int e = 0; e < ops->g_start[nr]; ++e) gt_start[s->red[ops->g_idx[e]] + 1]++;
+    for (int r = 0; r < r0; ++r) gt_start[r + 1] += gt_start[r];
+    int *gt_row = malloc(((size_t)gt_start[r0] + 1) * sizeof(int));
+    double *gt_val = malloc(((size_t)gt_start[r0] + 1) * sizeof(double));
+    int *fill = malloc(((size_t)r0 + 1) * sizeof(int));
+    int *row_n = calloc(2 * (size_t)r0 + 1, sizeof(int));
+    if (!gt_row || !gt_val || !fill || !row_n) {
+        free(gt_start);
+        free(gt_row);
+        free(gt_val);
+        free(fill);
+        free(row_n);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    memcpy(fill, gt_start, (size_t)r0 * sizeof(int));
+    for (int r = 0; r < nr; ++r)
+        for (int e = ops->g_start[r]; e < ops->g_start[r + 1]; ++e) {
+            int x = s->red[ops->g_idx[e]];
+            gt_row[fill[x]] = r;
+            gt_val[fill[x]++] = ops->area[r] * ops->g_val[e];
+        }
+    free(fill);
+    /* G's rows: dense accumulation per row (one per thread), two passes (count, write) */
+    double **G_vals = calloc((size_t)r0 + 1, sizeof(double *));
+    int **G_cols = calloc((size_t)r0 + 1, sizeof(int *));
+    int fail = 0;
+    if (!G_vals || !G_cols) fail = 1;
+#pragma omp parallel num_threads(o->nthreads) reduction(| : fail)
+    {
+        double *acc = calloc((size_t)n + 1, sizeof(double));
+        int *mark = malloc(((size_t)n + 1) * sizeof(int));
+        int *list = malloc(((size_t)n + 1) * sizeof(int));
+        if (!acc || !mark || !list) fail = 1;
+        if (mark)
+            for (int f = 0; f < n; ++f) mark[f] = -1;
+#pragma omp for schedule(dynamic, 4)
+        for (int rho = 0; rho < r0; ++rho) {
+            if (!acc || !mark || !list || !G_vals || !G_cols) continue;
+            int cnt = 0;
+            for (int t = gt_start[rho]; t < gt_start[rho + 1]; ++t) {
+                int r = gt_row[t];
+                for (int e = ops->j_start[r]; e < ops->j_start[r + 1]; ++e) {
+                    int f = o->free_index[ops->j_col[e]];
+                    if (f < 0) continue;
+                    if (mark[f] != rho) {
+                        mark[f] = rho;
+                        acc[f] = 0;
+                        list[cnt++] = f;
+                    }
+                    acc[f] += gt_val[t] * ops->j_val[e];
+                }
+            }
+            /* sorted columns (the sums above are in sample order already) */
+            for (int a = 1; a < cnt; ++a) {
+                int x = list[a], b = a - 1;
+                while (b >= 0 && list[b] > x) {
+                    list[b + 1] = list[b];
+                    --b;
+                }
+                list[b + 1] = x;
+            }
+            G_cols[rho] = malloc(((size_t)cnt + 1) * sizeof(int));
+            G_vals[rho] = malloc(((size_t)cnt + 1) * sizeof(double));
+            if (!G_cols[rho] || !G_vals[rho]) {
+                fail = 1;
+                continue;
+            }
+            for (int a = 0; a < cnt; ++a) {
+                G_cols[rho][a] = list[a];
+                G_vals[rho][a] = acc[list[a]];
+            }
+            row_n[r0 + rho] = cnt;
+        }
+        free(acc);
+        free(mark);
+        free(list);
+    }
+    sem_status st = SEM_OK;
+    if (fail) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the error matrix's coupling");
+        goto done;
+    }
+    for (int rho = 0; rho < r0; ++rho) {
+        int full = s->p_first[rho];
+        for (int e = ops->p_start[full]; e < ops->p_start[full + 1]; ++e)
+            if (o->free_index[ops->p_col[e]] >= 0) row_n[rho]++;
+    }
+    s->v_start = malloc((2 * (size_t)r0 + 1) * sizeof(int));
+    if (!s->v_start) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    s->v_start[0] = 0;
+    for (int r = 0; r < 2 * r0; ++r) s->v_start[r + 1] = s->v_start[r] + row_n[r];
+    size_t nnz = (size_t)s->v_start[2 * r0];
+    s->v_col = malloc((nnz + 1) * sizeof(int));
+    s->v_val = malloc((nnz + 1) * sizeof(double));
+    s->vt_start = calloc((size_t)n + 1, sizeof(int));
+    s->vt_row = malloc((nnz + 1) * sizeof(int));
+    s->vt_val = malloc((nnz + 1) * sizeof(double));
+    if (!s->v_col || !s->v_val || !s->vt_start || !s->vt_row || !s->vt_val) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coupling matrix");
+        goto done;
+    }
+    for (int rho = 0; rho < r0; ++rho) {
+        int at = s->v_start[rho], full = s->p_first[rho];
+        for (int e = ops->p_start[full]; e < ops->p_start[full + 1]; ++e) {
+            int f = o->free_index[ops->p_col[e]];
+            if (f < 0) continue;
+            s->v_col[at] = f;
+            s->v_val[at++] = ops->p_val[e];
+        }
+        memcpy(s->v_col + s->v_start[r0 + rho], G_cols[rho], (size_t)row_n[r0 + rho] * sizeof(int));
+        memcpy(s->v_val + s->v_start[r0 + rho], G_vals[rho], (size_t)row_n[r0 + rho] * sizeof(double));
+    }
+    for (size_t e = 0; e < nnz; ++e) s->vt_start[s->v_col[e] + 1]++;
+    for (int f = 0; f < n; ++f) s->vt_start[f + 1] += s->vt_start[f];
+    {
+        int *tf = malloc(((size_t)n + 1) * sizeof(int));
+        if (!tf) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        memcpy(tf, s->vt_start, (size_t)n * sizeof(int));
+        for (int r = 0; r < 2 * r0; ++r)
+            for (int e = s->v_start[r]; e < s->v_start[r + 1]; ++e) {
+                s->vt_row[tf[s->v_col[e]]] = r;
+                s->vt_val[tf[s->v_col[e]]++] = s->v_val[e];
+            }
+        free(tf);
+    }
+done:
+    if (G_vals)
+        for (int r = 0; r < r0; ++r) free(G_vals[r]);
+    if (G_cols)
+        for (int r = 0; r < r0; ++r) free(G_cols[r]);
+    free(G_vals);
+    free(G_cols);
+    free(gt_start);
+    free(gt_row);
+    free(gt_val);
+    free(row_n);
+    return st;
+}
+
+/* F = V S0^-1 V^T, F_CHUNK columns at a time. */
+static sem_status build_F(sem_structured_solver *s, sem_error *err)
+{
+    int R = 2 * s->r, n = s->n;
+    s->F = malloc(((size_t)R * R + 1) * sizeof(double));
+    cholmod_dense *B = cholmod_allocate_dense((size_t)n, F_CHUNK, (size_t)n, CHOLMOD_REAL, &s->common);
+    if (!s->F || !B) {
+        if (B) cholmod_free_dense(&B, &s->common);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the capacitance matrix");
+    }
+    for (int c0 = 0; c0 < R; c0 += F_CHUNK) {
+        int nc = R - c0 < F_CHUNK ? R - c0 : F_CHUNK;
+        double *bx = B->x;
+        B->ncol = (size_t)nc;
+        memset(bx, 0, (size_t)n * nc * sizeof(double));
+        for (int j = 0; j < nc; ++j)
+            for (int e = s->v_start[c0 + j]; e < s->v_start[c0 + j + 1]; ++e)
+                bx[(size_t)j * n + s->v_col[e]] = s->v_val[e];
+        cholmod_dense *X = cholmod_solve(CHOLMOD_A, s->L, B, &s->common);
+        if (!X) {
+            cholmod_free_dense(&B, &s->common);
+            return sem_error_set(err, SEM_ERR_NOMEM, "CHOLMOD solve failed");
+        }
+        const double *xx = X->x;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(s->o->nthreads)
+        for (int r = 0; r < R; ++r)
+            for (int j = 0; j < nc; ++j) {
+                double v = 0;
+                const double *col = xx + (size_t)j * n;
+                for (int e = s->v_start[r]; e < s->v_start[r + 1]; ++e) v += s->v_val[e] * col[s->v_col[e]];
+                s->F[(size_t)r * R + c0 + j] = v;
+            }
+        cholmod_free_dense(&X, &s->common);
+    }
+    B->ncol = F_CHUNK;
+    cholmod_free_dense(&B, &s->common);
+    /* exactly symmetric */
+    for (int r = 0; r < R; ++r)
+        for (int c = r + 1; c < R; ++c) {
+            double v = 0.5 * (s->F[(size_t)r * R + c] + s->F[(size_t)c * R + r]);
+            s->F[(size_t)r * R + c] = s->F[(size_t)c * R + r] = v;
+        }
+    return SEM_OK;
+}
+
+/* The constant part of the Schur complement: F1's Cholesky factor, Y = F1^-1 B and
+ * Hc = F3 - B^T Y, B = F2 - I. Returns 0 when F1 is not positive definite. */
+static int schur_constants(sem_structured_solver *s, sem_error *err)
+{
+    int r = s->r, R = 2 * r;
+    size_t rr = (size_t)r * r;
+    s->F1 = malloc(rr * sizeof(double) + 1);
+    s->Y = malloc(rr * sizeof(double) + 1);
+    s->Hc = malloc(rr * sizeof(double) + 1);
+    if (!s->F1 || !s->Y || !s->Hc) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    /* F1 column-major (symmetric: the same), B into Y column-major, then Y = F1^-1 B */
+    for (int a = 0; a < r; ++a)
+        for (int b = 0; b < r; ++b) {
+            s->F1[(size_t)b * r + a] = s->F[(size_t)a * R + b];
+            s->Y[(size_t)b * r + a] = s->F[(size_t)a * R + r + b] - (a == b ? 1.0 : 0.0);
+        }
+    if (LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', r, s->F1, r) != 0) return 0;
+    /* Hc = F3 - B^T Y with B still in Y: first Hc = F3, then the product after the solve */
+    double *B = malloc(rr * sizeof(double) + 1);
+    if (!B) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    memcpy(B, s->Y, rr * sizeof(double));
+    LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', r, r, s->F1, r, s->Y, r); /* Y = F1^-1 B (col-major) */
+    for (int a = 0; a < r; ++a)
+        for (int b = 0; b < r; ++b) s->Hc[(size_t)a * r + b] = s->F[(size_t)(r + a) * R + r + b];
+    /* Hc -= B^T Y: column-major B, Y are row-major B^T, Y^T: Hc(row-major) -= (B^T Y) */
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, r, r, r, -1.0, B, r, s->Y, r, 1.0, s->Hc, r);
+    free(B);
+    /* Hc is symmetric (exactly, after this) and stored either way; Y to row-major */
+    for (int a = 0; a < r; ++a)
+        for (int b = a + 1; b < r; ++b) {
+            double v = 0.5 * (s->Hc[(size_t)a * r + b] + s->Hc[(size_t)b * r + a]);
+            s->Hc[(size_t)a * r + b] = s->Hc[(size_t)b * r + a] = v;
+        }
+    double *Yr = malloc(rr * sizeof(double) + 1);
+    if (!Yr) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    for (int a = 0; a < r; ++a)
+        for (int b = 0; b < r; ++b) Yr[(size_t)a * r + b] = s->Y[(size_t)b * r + a];
+    free(s->Y);
+    s->Y = Yr;
+    return 1;
+}
+
+sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **out, sem_error *err)
+{
+    *out = NULL;
+    sem_structured_solver *s = calloc(1, sizeof *s);
+    if (!s) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    s->o = o;
+    s->n = o->n_free;
+    s->r0 = o->ops->r0;
+    cholmod_start(&s->common);
+    s->common.print = 0;
+    s->common.error_handler = NULL;
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(BLAS_THREADS);
+    sem_status st = reduce_rows(s, err);
+    if (st == SEM_OK) st = factor_S0(s, err);
+    if (st == SEM_OK) st = build_V(s, err);
+    if (st == SEM_OK) st = build_F(s, err);
+    if (st == SEM_OK) {
+        int k = schur_constants(s, err);
+        if (k < 0) st = SEM_ERR_NOMEM;
+        s->schur = k == 1;
+    }
+    openblas_set_num_threads(blas_threads);
+    if (st == SEM_OK) {
+        size_t N = (size_t)(s->schur ? 3 : 6) * s->r;
+        s->C = malloc((N * N + 1) * sizeof(double));
+        s->ipiv = malloc((N + 1) * sizeof(lapack_int));
+        s->work = malloc((6 * (size_t)o->n_ctrl + 12 * (size_t)s->r + 1) * sizeof(double));
+        if (!s->C || !s->ipiv || !s->work)
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %zu x %zu capacitance matrix", N, N);
+    }
+    if (st != SEM_OK) {
+        sem_structured_solver_destroy(s);
+        return st;
+    }
+    *out = s;
+    return SEM_OK;
+}
+
+void sem_structured_solver_set(sem_structured_solver *s, const double c[4])
+{
+    memcpy(s->coef, c, sizeof s->coef);
+}
+
+double sem_structured_solver_factor_seconds(const sem_structured_solver *s)
+{
+    return s->last_factor_s;
+}
+
+/* T += sign Z~/c with Z~/c = Bb + Bz + (cM Mz + cK Kz + cD K0z) / c reduced to the distinct
+ * rows; T column-major with leading dimension ld, entry (3 rho + d) at offset off. */
+static void add_Z(sem_structured_solver *s, double *T, size_t ld, size_t off, double sign)
+{
+    const sem_object *o = s->o;
+    const sem_structured_ops *ops = o->ops;
+    int r0 = s->r0, m = o->m, M3 = 3 * m;
+    double c = 2.0 * s->coef[1], cM = s->coef[0] / c, cK = s->coef[2] / c, cD = s->coef[3] / c;
+    /* scalar parts (the same for each coordinate); duplicates add up, so serial */
+    for (int a = 0; a < r0; ++a) {
+        size_t ia = off + 3 * (size_t)s->red[a];
+        for (int b = 0; b < r0; ++b) {
+            size_t at = (size_t)a * r0 + b;
+            double v = ops->Bb[at] + ops->Bz[at] + cM * ops->Mz[at];
+            if (v == 0) continue;
+            size_t ib = off + 3 * (size_t)s->red[b];
+            for (int d = 0; d < 3; ++d) T[(ib + d) * ld + ia + d] += sign * v;
+        }
+    }
+    if (cK == 0 && cD == 0) return;
+    /* stiffness: per stored pair (a <= b with points), its own-basis blocks (a, b), (b, a) */
+    int ma = o->ma, n3 = 3 * ma;
+    size_t bs = (size_t)n3 * n3;
+    double Kc[27 * 27], blk[30 * 30];
+    for (int pr = 0; pr < o->n_pairs; ++pr) {
+        int a = o->pair_a[pr], b = o->pair_b[pr];
+        if (a > b || o->plist_start[pr + 1] == o->plist_start[pr]) continue;
+        const double *K = o->Kz + (size_t)pr * bs, *K0 = o->K0z + (size_t)pr * bs;
+        for (size_t e = 0; e < bs; ++e) Kc[e] = cK * K[e] + cD * K0[e];
+        for (int t = 0; t < (a == b ? 1 : 2); ++t) {
+            sem_structured_own_basis(o, a, b, Kc, t, blk);
+            int pa = t ? b : a, pb = t ? a : b;
+            for (int x = 0; x < M3; ++x) {
+                size_t ia = off + 3 * (size_t)s->red[pa * m + x / 3] + (size_t)(x % 3);
+                for (int y = 0; y < M3; ++y) {
+                    size_t ib = off + 3 * (size_t)s->red[pb * m + y / 3] + (size_t)(y % 3);
+                    T[ib * ld + ia] += sign * blk[(size_t)x * M3 + y];
+                }
+            }
+        }
+    }
+}
+
+sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *err)
+{
+    double t0 = omp_get_wtime();
+    if (!(s->coef[1] > 0)) return sem_error_set(err, SEM_ERR_INVALID, "structured solver: no error term");
+    int r = s->r, R = 2 * r;
+    size_t N = (size_t)(s->schur ? 3 : 6) * r;
+    memset(s->C, 0, N * N * sizeof(double));
+    lapack_int info;
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(BLAS_THREADS);
+    if (s->schur) {
+        /* H = Z~/c - Hc (x) I3 */
+        for (int a = 0; a < r; ++a)
+            for (int b = 0; b < r; ++b) {
+                double v = s->Hc[(size_t)a * r + b];
+                for (int d = 0; d < 3; ++d) s->C[(3 * (size_t)b + d) * N + 3 * (size_t)a + d] = -v;
+            }
+        add_Z(s, s->C, N, 0, 1.0);
+        info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N);
+        openblas_set_num_threads(blas_threads);
+        s->last_factor_s = omp_get_wtime() - t0;
+        if (info != 0)
+            return sem_error_set(err, SEM_ERR_NUMERIC,
+                                 "system matrix is not positive definite (coefficient-space pivot "
+                                 "%d): the state may have exploded or the object is not held",
+                                 (int)info);
+        return SEM_OK;
+    }
+    /* the whole capacitance [[F1, F2 - I], [F2^T - I, F3 - Z~/c]] (x) I3, index b 3r + 3 rho + d */
+    for (int a = 0; a < R; ++a)
+        for (int b = 0; b < R; ++b) {
+            double v = s->F[(size_t)a * R + b];
+            int ba = a >= r, bb = b >= r, ra = a - ba * r, rb = b - bb * r;
+            if (ba != bb && ra == rb) v -= 1.0;
+            if (v == 0) continue;
+            size_t ia = (size_t)ba * 3 * r + 3 * (size_t)ra, ib = (size_t)bb * 3 * r + 3 * (size_t)rb;
+            for (int d = 0; d < 3; ++d) s->C[(ib + d) * N + ia + d] = v;
+        }
+    add_Z(s, s->C, N, 3 * (size_t)r, -1.0);
+    info = LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N, s->ipiv);
+    openblas_set_num_threads(blas_threads);
+    s->last_factor_s = omp_get_wtime() - t0;
+    if (info != 0)
+        return sem_error_set(err, SEM_ERR_NUMERIC,
+                             "system matrix is singular (capacitance pivot %d): the state may have "
+                             "exploded or the object is not held",
+                             (int)info);
+    /* inertia: positive definite exactly when half the eigenvalues are negative */
+    int neg = 0;
+    for (size_t k = 0; k < N;) {
+        double d11 = s->C[k * N + k];
+        if (s->ipiv[k] > 0) {
+            neg += d11 < 0;
+            k += 1;
+        } else {
+            double d22 = s->C[(k + 1) * N + k + 1], d21 = s->C[k * N + k + 1];
+            double det = d11 * d22 - d21 * d21;
+            neg += det < 0 ? 1 : (d11 < 0 ? 2 : 0);
+            k += 2;
+        }
+    }
+    if (neg != 3 * r)
+        return sem_error_set(err, SEM_ERR_NUMERIC,
+                             "system matrix is not positive definite (%d of %d capacitance "
+                             "eigenvalues negative): the state may have exploded or the object is "
+                             "not held",
+                             neg, 3 * r);
+    return SEM_OK;
+}
+
+/* w = Cap~^-1 v in place; v = [v1; v2], 3r each (index 3 rho + d). */
+static void capacitance_solve(sem_structured_solver *s, double *v)
+{
+    int r = s->r;
+    lapack_int info = 0, one = 1;
+    char uplo = 'L';
+    if (!s->schur) {
+        /* LAPACK itself: LAPACKE would scan the N x N factor for NaN on every solve */
+        lapack_int N = 6 * r;
+        LAPACK_dsytrs(&uplo, &N, &one, s->C, &N, s->ipiv, v, &N, &info);
+        return;
+    }
+    double *v1 = v, *v2 = v + 3 * (size_t)r, *t = s->work + 6 * (size_t)s->o->n_ctrl + 6 * (size_t)r;
+    /* u = v2 - Y^T v1 (v as r x 3 row-major), w2 = -H^-1 u */
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, r, 3, r, -1.0, s->Y, r, v1, 3, 1.0, v2, 3);
+    lapack_int N3 = 3 * r;
+    LAPACK_dpotrs(&uplo, &N3, &one, s->C, &N3, v2, &N3, &info);
+    for (int k = 0; k < 3 * r; ++k) v2[k] = -v2[k];
+    /* w1 = F1^-1 (v1 - B w2), B = F2 - I: t = v1 - F2 w2 + w2 */
+    int R = 2 * r;
+    for (int a = 0; a < r; ++a)
+        for (int d = 0; d < 3; ++d) {
+            double acc = v1[3 * a + d] + v2[3 * a + d];
+            const double *f = s->F + (size_t)a * R + r;
+            for (int b = 0; b < r; ++b) acc -= f[b] * v2[3 * b + d];
+            t[(size_t)d * r + a] = acc; /* column-major r x 3 for dpotrs */
+        }
+    lapack_int rr = r, three = 3;
+    LAPACK_dpotrs(&uplo, &rr, &three, s->F1, &rr, t, &rr, &info);
+    for (int a = 0; a < r; ++a)
+        for (int d = 0; d < 3; ++d) v1[3 * a + d] = t[(size_t)d * r + a];
+}
+
+/* x = A^-1 b by Woodbury (to round-off of the factored form); b, x: 3n free values. */
+static void woodbury(sem_structured_solver *s, const double *b, double *x)
+{
+    int n = s->n, r = s->r, R = 2 * r;
+    double c = 2.0 * s->coef[1];
+    cholmod_dense *B = cholmod_allocate_dense((size_t)n, 3, (size_t)n, CHOLMOD_REAL, &s->common);
+    if (!B) return;
+    double *bx = B->x;
+    for (int f = 0; f < n; ++f)
+        for (int d = 0; d < 3; ++d) bx[(size_t)d * n + f] = b[3 * (size_t)f + d];
+    cholmod_dense *T = cholmod_solve(CHOLMOD_A, s->L, B, &s->common);
+    double *w = s->work + 6 * (size_t)s->o->n_ctrl;
+    const double *t = T ? T->x : NULL;
+    if (!t) {
+        cholmod_free_dense(&B, &s->common);
+        return;
+    }
+    /* w = V t: rows of P~ then of G~, 3 rho + d each */
+#pragma omp parallel for schedule(static) num_threads(s->o->nthreads)
+    for (int row = 0; row < R; ++row) {
+        double a[3] = {0, 0, 0};
+        for (int e = s->v_start[row]; e < s->v_start[row + 1]; ++e)
+            for (int d = 0; d < 3; ++d) a[d] += s->v_val[e] * t[(size_t)d * n + s->v_col[e]];
+        for (int d = 0; d < 3; ++d) w[3 * (size_t)row + d] = a[d];
+    }
+    capacitance_solve(s, w);
+    /* B = V^T w */
+#pragma omp parallel for schedule(static) num_threads(s->o->nthreads)
+    for (int f = 0; f < n; ++f) {
+        double a[3] = {0, 0, 0};
+        for (int e = s->vt_start[f]; e < s->vt_start[f + 1]; ++e) {
+            const double *wr = w + 3 * (size_t)s->vt_row[e];
+            for (int d = 0; d < 3; ++d) a[d] += s->vt_val[e] * wr[d];
+        }
+        for (int d = 0; d < 3; ++d) bx[(size_t)d * n + f] = a[d];
+    }
+    cholmod_dense *X = cholmod_solve(CHOLMOD_A, s->L, B, &s->common);
+    const double *xx = X ? X->x : NULL;
+    for (int f = 0; f < n; ++f)
+        for (int d = 0; d < 3; ++d)
+            x[3 * (size_t)f + d] = (t[(size_t)d * n + f] - (xx ? xx[(size_t)d * n + f] : 0)) / c;
+    cholmod_free_dense(&B, &s->common);
+    cholmod_free_dense(&T, &s->common);
+    if (X) cholmod_free_dense(&X, &s->common);
+}
+
+/* y = A x over the free dofs (the exact products of structured_operators.c). */
+static void apply_A(sem_structured_solver *s, const double *x, double *y)
+{
+    const sem_object *o = s->o;
+    size_t nf = 3 * (size_t)o->n_ctrl;
+    double *xf = s->work, *yf = s->work + nf;
+    memset(xf, 0, nf * sizeof(double));
+    for (int c = 0; c < o->n_ctrl; ++c) {
+        int f = o->free_index[c];
+        if (f >= 0)
+            for (int d = 0; d < 3; ++d) xf[3 * (size_t)c + d] = x[3 * (size_t)f + d];
+    }
+    sem_structured_multiply(o, s->coef[0], s->coef[1], s->coef[2], s->coef[3], xf, yf);
+    for (int c = 0; c < o->n_ctrl; ++c) {
+        int f = o->free_index[c];
+        if (f >= 0)
+            for (int d = 0; d < 3; ++d) y[3 * (size_t)f + d] = yf[3 * (size_t)c + d];
+    }
+}
+
+static double dot(const double *a, const double *b, size_t n)
+{
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    size_t i = 0;
+    for (; i + 3 < n; i += 4) {
+        s0 += a[i] * b[i];
+        s1 += a[i + 1] * b[i + 1];
+        s2 += a[i + 2] * b[i + 2];
+        s3 += a[i + 3] * b[i + 3];
+    }
+    for (; i < n; ++i) s0 += a[i] * b[i];
+    return (s0 + s1) + (s2 + s3);
+}
+
+sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b, double *x,
+                                       sem_error *err)
+{
+    size_t n3 = 3 * (size_t)s->n;
+    if (n3 == 0) return SEM_OK;
+    /* b, the residual, the preconditioned residual, the direction and A p */
+    double *bb = malloc(5 * n3 * sizeof(double));
+    if (!bb) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory in the solve");
+    double *rr = bb + n3, *zz = rr + n3, *p = zz + n3, *q = p + n3;
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(BLAS_THREADS);
+    memcpy(bb, b, n3 * sizeof(double));
+    double bnorm = sqrt(dot(bb, bb, n3));
+    sem_status st = SEM_OK;
+    woodbury(s, bb, x);
+    if (bnorm == 0) goto done;
+    apply_A(s, x, q);
+    for (size_t i = 0; i < n3; ++i) rr[i] = bb[i] - q[i];
+    double rnorm = sqrt(dot(rr, rr, n3));
+    if (rnorm <= CG_TOLERANCE * bnorm) goto done;
+    woodbury(s, rr, zz);
+    memcpy(p, zz, n3 * sizeof(double));
+    double rz = dot(rr, zz, n3);
+    int it;
+    for (it = 0; it < CG_MAX_ITERATIONS; ++it) {
+        apply_A(s, p, q);
+        double pq = dot(p, q, n3);
+        if (!(pq > 0)) break;
+        double alpha = rz / pq;
+        for (size_t i = 0; i < n3; ++i) {
+            x[i] += alpha * p[i];
+            rr[i] -= alpha * q[i];
+        }
+        rnorm = sqrt(dot(rr, rr, n3));
+        if (rnorm <= CG_TOLERANCE * bnorm) break;
+        woodbury(s, rr, zz);
+        double rz1 = dot(rr, zz, n3);
+        double beta = rz1 / rz;
+        rz = rz1;
+        for (size_t i = 0; i < n3; ++i) p[i] = zz[i] + beta * p[i];
+    }
+    if (!(rnorm <= CG_FAIL * bnorm))
+        st = sem_error_set(err, SEM_ERR_NUMERIC,
+                           "the structured solve did not converge (relative residual %.2g after %d "
+                           "refinement iterations)",
+                           rnorm / bnorm, it);
+done:
+    openblas_set_num_threads(blas_threads);
+    free(bb);
+    return st;
+}
