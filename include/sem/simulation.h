@@ -28,7 +28,8 @@ typedef enum sem_integrator {
 } sem_integrator;
 
 typedef enum sem_solver_choice {
-    SEM_SOLVER_AUTO,   /* a fixed rule: dense up to 500 dofs, CHOLMOD above (reproducible) */
+    SEM_SOLVER_AUTO,   /* a fixed rule: structured when the control points are at least twice the
+                          coefficients (n_parts m), else dense up to 500 dofs, CHOLMOD above */
     SEM_SOLVER_SPARSE, /* CHOLMOD */
     SEM_SOLVER_DENSE,  /* LAPACK dpotrf */
     SEM_SOLVER_STRUCTURED /* part-sparse plus low rank through Pi (Woodbury); no q-space matrix */
@@ -67,6 +68,11 @@ typedef struct sem_world_def {
 } sem_world_def;
 
 sem_world_def sem_default_world_def(void);
+/* 1 when a world with these settings solves an object of n_ctrl control points, n_parts
+ * parts and n_basis polynomial terms (4 or 10) with the structured solver (the rule of
+ * SEM_SOLVER_AUTO); its discretization then needs no q-space operators
+ * (sem_preprocess_options.q_space_operators), which the other solvers do. */
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis);
 
 typedef enum sem_prescribe_type {
     SEM_PRESCRIBE_NONE,

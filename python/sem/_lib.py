@@ -169,7 +169,8 @@ class sem_preprocess_options(Structure):
     _fields_ = [("order", c_int), ("spacing", c_double), ("rays", c_int * 2), ("ray_axis", c_int),
                 ("points_per_interval", c_int), ("alpha", c_double), ("sparsity", c_double),
                 ("weight_threshold", c_double), ("origin_rule", c_int), ("gamma", c_double),
-                ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int)]
+                ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int),
+                ("q_space_operators", c_int)]
 
 
 class sem_preprocess_timings(Structure):

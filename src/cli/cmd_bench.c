@@ -54,6 +54,14 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
         po = sem_default_preprocess_options();
         po.youngs_modulus = r->youngs_modulus;
     }
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.8;
+    wd.dt = 0.01;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    wd.solver = solver;
+    /* the q-space operators only for the solvers that use them */
+    po.q_space_operators =
+        !sem_world_def_structured(&wd, sem_model_control_points(m), m->n_parts, po.order == 1 ? 4 : 10);
     sem_discretization *d = NULL;
     sem_world *w = NULL;
     for (int k = 0; k < repeat; ++k) {
@@ -66,11 +74,6 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     }
     out->dofs = 3 * d->n_ctrl;
 
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = -9.8;
-    wd.dt = 0.01;
-    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
-    wd.solver = solver;
     w = sem_world_create(&wd, err);
     if (!w) {
         st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;

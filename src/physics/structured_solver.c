@@ -35,6 +35,8 @@
  */
 #include "structured.h"
 
+#include "sem/limits.h"
+
 #include <cblas.h>
 #include <lapacke.h>
 #include <math.h>
@@ -443,6 +445,11 @@ sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **o
     int blas_threads = openblas_get_num_threads();
     openblas_set_num_threads(BLAS_THREADS);
     sem_status st = reduce_rows(s, err);
+    if (st == SEM_OK && 3 * (size_t)s->r > SEM_MAX_STRUCTURED_COEFFICIENTS)
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "%d parts make a %d x %d coefficient matrix (limit "
+                           "SEM_MAX_STRUCTURED_COEFFICIENTS = %d): use the sparse solver",
+                           o->n_parts, 3 * s->r, 3 * s->r, SEM_MAX_STRUCTURED_COEFFICIENTS);
     if (st == SEM_OK) st = factor_S0(s, err);
     if (st == SEM_OK) st = build_V(s, err);
     if (st == SEM_OK) st = build_F(s, err);

@@ -25,6 +25,7 @@
 #include "runaway.h"
 #include "loads.h"
 #include "system.h"
+#include "sem/limits.h"
 #include "structured.h"
 
 sem_world_def sem_default_world_def(void)
@@ -158,6 +159,14 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
     return &o->def.material;
 }
 
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis)
+{
+    size_t r0 = (size_t)n_parts * (size_t)n_basis;
+    return def->solver == SEM_SOLVER_STRUCTURED ||
+           (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && n_ctrl >= 2 * r0 &&
+            3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS);
+}
+
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
 {
     if (!def->model || !def->disc) {
@@ -244,7 +253,18 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_object_free_dofs(o, err)) != SEM_OK) goto fail;
     /* error stiffness: the object's, else the discretization's default */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
-    o->structured = w->def.solver == SEM_SOLVER_STRUCTURED;
+    /* the structured solver (structured.h) when asked, and by the fixed rule of
+     * SEM_SOLVER_AUTO: when the coefficient space (n_parts m per coordinate) is at most half
+     * the control points, where its factorization is far cheaper than the q-space one (the
+     * objects of one system must agree, so solving together keeps the q-space solvers) */
+    o->structured = sem_world_def_structured(&w->def, (size_t)o->n_ctrl, o->n_parts, o->m);
+    if (!o->structured && sem_csr_nnz(&d->M) == 0 && o->n_ctrl > 0) {
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "the %s solver needs the q-space operators: preprocess with "
+                           "q_space_operators (or use the structured solver)",
+                           w->def.solver == SEM_SOLVER_DENSE ? "dense" : "sparse");
+        goto fail;
+    }
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;

@@ -69,6 +69,7 @@ sem_preprocess_options sem_default_preprocess_options(void)
     o.youngs_modulus = 1e6;
     o.tessellation = 16;
     o.threads = 0;
+    o.q_space_operators = -1;
     return o;
 }
 
@@ -190,6 +191,15 @@ static void hash_loop(fnv *f, const sem_trim_loop *l)
     for (int k = 0; k < l->n_curves && l->curves; ++k) hash_curve(f, &l->curves[k]);
 }
 
+int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o)
+{
+    if (o->q_space_operators >= 0) return o->q_space_operators != 0;
+    /* the rule of SEM_SOLVER_AUTO for a default world (sem_world_def_structured) */
+    size_t n_ctrl = model ? sem_model_control_points(model) : 0;
+    size_t n_parts = model ? (size_t)model->n_parts : 0, m = o->order == 1 ? 4 : 10;
+    return n_ctrl < 2 * n_parts * m || 3 * n_parts * m > SEM_MAX_STRUCTURED_COEFFICIENTS;
+}
+
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o)
 {
     fnv f;
@@ -232,6 +242,7 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
         fnv_doubles(&f, v, 6);
         fnv_int(&f, o->tessellation);
         fnv_int(&f, o->origin_rule);
+        fnv_int(&f, sem_preprocess_q_space(model, o));
     }
     return (unsigned long long)f.h;
 }
@@ -356,11 +367,16 @@ static sem_status check_sizes(const sem_model *model, const sem_preprocess_optio
         triangles += 2.0 * su * sv * o->tessellation * o->tessellation;
         ctrl += (double)s->n_u * s->n_v;
     }
-    if (ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+    if (sem_preprocess_q_space(model, o) && ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
+                                                   "with the q-space operators takes at most %d "
+                                                   "(limit SEM_MAX_PREPROCESS_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+    if (ctrl > SEM_MAX_STRUCTURED_CONTROL_POINTS)
         return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
                                                    "takes at most %d (limit "
-                                                   "SEM_MAX_PREPROCESS_CONTROL_POINTS)",
-                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+                                                   "SEM_MAX_STRUCTURED_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_STRUCTURED_CONTROL_POINTS);
     if (entries > SEM_MAX_BOUNDARY_ENTRIES)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "boundary sampling would store %.3g basis values (samples times "
@@ -415,6 +431,7 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     d->order = o.order;
     d->n_basis = o.order == 1 ? 4 : 10;
     d->model_hash = sem_preprocess_hash(model, &o);
+    o.q_space_operators = sem_preprocess_q_space(model, &o);
 
     double t0 = omp_get_wtime();
     st = sem_step_sample(model, d, err);

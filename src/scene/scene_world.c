@@ -185,7 +185,11 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     logf_(o, 0, "object %d: %d parts, %zu dofs; preprocessing...", i, model->n_parts,
           3 * sem_model_control_points(model));
     int cached = 0;
-    st = preprocess_cached(model, &so->sem, o, &sw->discs[i], &cached, err);
+    /* the q-space operators only for the solvers that use them */
+    sem_preprocess_options popt = so->sem;
+    popt.q_space_operators = !sem_world_def_structured(&scene->world, sem_model_control_points(model),
+                                                       model->n_parts, popt.order == 1 ? 4 : 10);
+    st = preprocess_cached(model, &popt, o, &sw->discs[i], &cached, err);
     if (st != SEM_OK) return prefix_error(err, st, name, i, ": ");
     sw->all_cached &= cached;
     logf_(o, 0, "object %d: %s: %d quadrature points, volume %.6g", i,
