@@ -70,12 +70,17 @@ struct sem_structured_solver {
     int *vt_start, *vt_row;
     double *vt_val;
     double *F;      /* 2r x 2r, row-major: V S0^-1 V^T */
-    int schur;      /* 1: F1 eliminated (H), 0: the whole capacitance (fallback) */
-    double *F1;     /* r x r column-major Cholesky factor of F1 */
-    double *Y;      /* r x r row-major: F1^-1 B */
-    double *Hc;     /* r x r row-major: F3 - B^T F1^-1 B */
-    double *C;      /* schur: H (3r square); else the 6r capacitance; column-major, factored */
-    lapack_int *ipiv;
+    /* the well-conditioned basis of P~'s row space (schur_constants): k of the r rows */
+    int k;
+    double *T;      /* r x k, row-major: U_k Lambda_k^-1/2 (new P rows = T^T P~) */
+    double *Ep;     /* r x k, row-major: U_k Lambda_k^1/2 (P~ = Ep P' on the kept space) */
+    double *Bp;     /* k x k, row-major: F2' - I */
+    double *Hc;     /* k x k, row-major: F3' - B'^T B' */
+    double *C;      /* H' (3k square), column-major, then its Cholesky factor */
+    double *H;      /* H' before its factorization (for a shifted retry) */
+    double *Zt;     /* 3r square: Z~/c; then 3r x 3k: Z~/c (Ep (x) I3) */
+    double *Ep3;    /* 3r x 3k column-major: Ep (x) I3 */
+    double shift;   /* the diagonal shift the last factorization needed (0: none) */
     double coef[4];
     double last_factor_s;
     double *work;
@@ -95,11 +100,14 @@ void sem_structured_solver_destroy(sem_structured_solver *s)
     free(s->vt_row);
     free(s->vt_val);
     free(s->F);
-    free(s->F1);
-    free(s->Y);
+    free(s->T);
+    free(s->Ep);
+    free(s->Bp);
     free(s->Hc);
     free(s->C);
-    free(s->ipiv);
+    free(s->H);
+    free(s->Zt);
+    free(s->Ep3);
     free(s->work);
     free(s);
 }
@@ -380,55 +388,94 @@ static sem_status build_F(sem_structured_solver *s, sem_error *err)
     return SEM_OK;
 }
 
-/* The constant part of the Schur complement: F1's Cholesky factor, Y = F1^-1 B and
- * Hc = F3 - B^T Y, B = F2 - I. Returns 0 when F1 is not positive definite. */
-static int schur_constants(sem_structured_solver *s, sem_error *err)
+/* F1 = P~ S0^-1 P~^T is positive semi-definite but can be nearly singular: parts of one
+ * origin whose fits are nearly dependent (a flat face whose linear fit is determined only
+ * through its origin). Its eigenvectors give a basis of P~'s row space in which F1 is the
+ * identity: P' = T^T P~ with T = U_k Lambda_k^-1/2 over the eigenvalues above
+ * F1_CUTOFF x the largest; the others are directions that P~^T barely reaches, whose omission
+ * only perturbs the preconditioner (conjugate gradients solve with the exact A). With
+ * Ep = U_k Lambda_k^1/2 (P~ = Ep P' on the kept space): F2' = T^T F2 Ep, F3' = Ep^T F3 Ep,
+ * B' = F2' - I and the constant Hc = F3' - B'^T B'. */
+#define F1_CUTOFF 1e-12
+static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
 {
     int r = s->r, R = 2 * r;
     size_t rr = (size_t)r * r;
-    s->F1 = malloc(rr * sizeof(double) + 1);
-    s->Y = malloc(rr * sizeof(double) + 1);
-    s->Hc = malloc(rr * sizeof(double) + 1);
-    if (!s->F1 || !s->Y || !s->Hc) {
-        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        return -1;
+    double *U = malloc(rr * sizeof(double) + 1), *lam = malloc((size_t)r * sizeof(double) + 1);
+    if (!U || !lam) {
+        free(U);
+        free(lam);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
-    /* F1 column-major (symmetric: the same), B into Y column-major, then Y = F1^-1 B */
+    /* Jacobi scaling first: the rows of P~ differ in scale by powers of the model size (the
+     * basis terms 1, X, X^2), so the cut-off applies to D^-1/2 F1 D^-1/2, D = diag F1 */
+    double *dsq = malloc((size_t)r * sizeof(double) + 1);
+    if (!dsq) {
+        free(U);
+        free(lam);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int a = 0; a < r; ++a) {
+        double v = s->F[(size_t)a * R + a];
+        dsq[a] = v > 0 ? sqrt(v) : 0;
+    }
     for (int a = 0; a < r; ++a)
-        for (int b = 0; b < r; ++b) {
-            s->F1[(size_t)b * r + a] = s->F[(size_t)a * R + b];
-            s->Y[(size_t)b * r + a] = s->F[(size_t)a * R + r + b] - (a == b ? 1.0 : 0.0);
+        for (int b = 0; b < r; ++b)
+            U[(size_t)a * r + b] = dsq[a] > 0 && dsq[b] > 0 ? s->F[(size_t)a * R + b] / (dsq[a] * dsq[b]) : 0;
+    lapack_int info = r > 0 ? LAPACKE_dsyevd(LAPACK_ROW_MAJOR, 'V', 'L', r, U, r, lam) : 0;
+    if (info != 0) {
+        free(U);
+        free(lam);
+        free(dsq);
+        return sem_error_set(err, SEM_ERR_NUMERIC, "structured solver: eigenvalues of F1 failed (%d)", (int)info);
+    }
+    double lmax = r > 0 ? lam[r - 1] : 0;
+    int first = 0;
+    while (first < r && !(lam[first] > F1_CUTOFF * lmax)) first++;
+    int k = s->k = r - first;
+    if (getenv("SEM_DEBUG_CG")) {
+        fprintf(stderr, "F1 r %d lmax %.3g:", r, lmax);
+        for (int q = 0; q < r && q < 12; ++q) fprintf(stderr, " %.2g", lam[q] / lmax);
+        fprintf(stderr, "\n");
+    }
+    s->T = malloc(((size_t)r * k + 1) * sizeof(double));
+    s->Ep = malloc(((size_t)r * k + 1) * sizeof(double));
+    s->Bp = malloc(((size_t)k * k + 1) * sizeof(double));
+    s->Hc = malloc(((size_t)k * k + 1) * sizeof(double));
+    double *X = malloc(((size_t)r * k + 1) * sizeof(double));
+    if (!s->T || !s->Ep || !s->Bp || !s->Hc || !X) {
+        free(U);
+        free(lam);
+        free(X);
+        free(dsq);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    /* eigenvectors are U's columns (row-major: U[a][j]) */
+    for (int a = 0; a < r; ++a)
+        for (int j = 0; j < k; ++j) {
+            double u = U[(size_t)a * r + first + j], l = lam[first + j];
+            s->T[(size_t)a * k + j] = dsq[a] > 0 ? u / (dsq[a] * sqrt(l)) : 0;
+            s->Ep[(size_t)a * k + j] = u * dsq[a] * sqrt(l);
         }
-    if (LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', r, s->F1, r) != 0) return 0;
-    /* Hc = F3 - B^T Y with B still in Y: first Hc = F3, then the product after the solve */
-    double *B = malloc(rr * sizeof(double) + 1);
-    if (!B) {
-        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        return -1;
-    }
-    memcpy(B, s->Y, rr * sizeof(double));
-    LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', r, r, s->F1, r, s->Y, r); /* Y = F1^-1 B (col-major) */
-    for (int a = 0; a < r; ++a)
-        for (int b = 0; b < r; ++b) s->Hc[(size_t)a * r + b] = s->F[(size_t)(r + a) * R + r + b];
-    /* Hc -= B^T Y: column-major B, Y are row-major B^T, Y^T: Hc(row-major) -= (B^T Y) */
-    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, r, r, r, -1.0, B, r, s->Y, r, 1.0, s->Hc, r);
-    free(B);
-    /* Hc is symmetric (exactly, after this) and stored either way; Y to row-major */
-    for (int a = 0; a < r; ++a)
-        for (int b = a + 1; b < r; ++b) {
-            double v = 0.5 * (s->Hc[(size_t)a * r + b] + s->Hc[(size_t)b * r + a]);
-            s->Hc[(size_t)a * r + b] = s->Hc[(size_t)b * r + a] = v;
+    /* F2' = T^T F2 Ep: X = F2 Ep (r x k), then T^T X */
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, k, r, 1.0, s->F + r, R, s->Ep, k, 0.0, X, k);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, k, r, 1.0, s->T, k, X, k, 0.0, s->Bp, k);
+    for (int j = 0; j < k; ++j) s->Bp[(size_t)j * k + j] -= 1.0;
+    /* F3' = Ep^T F3 Ep, then Hc = F3' - B'^T B' */
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, k, r, 1.0, s->F + (size_t)r * R + r, R, s->Ep, k,
+                0.0, X, k);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, k, r, 1.0, s->Ep, k, X, k, 0.0, s->Hc, k);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, k, k, -1.0, s->Bp, k, s->Bp, k, 1.0, s->Hc, k);
+    for (int a = 0; a < k; ++a)
+        for (int b = a + 1; b < k; ++b) {
+            double v = 0.5 * (s->Hc[(size_t)a * k + b] + s->Hc[(size_t)b * k + a]);
+            s->Hc[(size_t)a * k + b] = s->Hc[(size_t)b * k + a] = v;
         }
-    double *Yr = malloc(rr * sizeof(double) + 1);
-    if (!Yr) {
-        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        return -1;
-    }
-    for (int a = 0; a < r; ++a)
-        for (int b = 0; b < r; ++b) Yr[(size_t)a * r + b] = s->Y[(size_t)b * r + a];
-    free(s->Y);
-    s->Y = Yr;
-    return 1;
+    free(U);
+    free(lam);
+    free(X);
+    free(dsq);
+    return SEM_OK;
 }
 
 sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **out, sem_error *err)
@@ -453,19 +500,22 @@ sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **o
     if (st == SEM_OK) st = factor_S0(s, err);
     if (st == SEM_OK) st = build_V(s, err);
     if (st == SEM_OK) st = build_F(s, err);
-    if (st == SEM_OK) {
-        int k = schur_constants(s, err);
-        if (k < 0) st = SEM_ERR_NOMEM;
-        s->schur = k == 1;
-    }
+    if (st == SEM_OK) st = schur_constants(s, err);
     openblas_set_num_threads(blas_threads);
     if (st == SEM_OK) {
-        size_t N = (size_t)(s->schur ? 3 : 6) * s->r;
+        size_t N = 3 * (size_t)s->k, N3r = 3 * (size_t)s->r;
         s->C = malloc((N * N + 1) * sizeof(double));
-        s->ipiv = malloc((N + 1) * sizeof(lapack_int));
+        s->H = malloc((N * N + 1) * sizeof(double));
+        s->Zt = malloc((N3r * (N3r > N ? N3r : N) + 1) * sizeof(double));
+        s->Ep3 = calloc(N3r * N + 1, sizeof(double));
         s->work = malloc((6 * (size_t)o->n_ctrl + 12 * (size_t)s->r + 1) * sizeof(double));
-        if (!s->C || !s->ipiv || !s->work)
-            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %zu x %zu capacitance matrix", N, N);
+        if (!s->C || !s->H || !s->Zt || !s->Ep3 || !s->work)
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %zu x %zu coefficient matrix", N, N);
+        else
+            for (int a2 = 0; a2 < s->r; ++a2)
+                for (int j = 0; j < s->k; ++j)
+                    for (int d = 0; d < 3; ++d)
+                        s->Ep3[(3 * (size_t)j + d) * N3r + 3 * (size_t)a2 + d] = s->Ep[(size_t)a2 * s->k + j];
     }
     if (st != SEM_OK) {
         sem_structured_solver_destroy(s);
@@ -532,103 +582,83 @@ sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *
 {
     double t0 = omp_get_wtime();
     if (!(s->coef[1] > 0)) return sem_error_set(err, SEM_ERR_INVALID, "structured solver: no error term");
-    int r = s->r, R = 2 * r;
-    size_t N = (size_t)(s->schur ? 3 : 6) * r;
-    memset(s->C, 0, N * N * sizeof(double));
-    lapack_int info;
+    int k = s->k;
+    size_t N = 3 * (size_t)k, N3r = 3 * (size_t)s->r;
     int blas_threads = openblas_get_num_threads();
     openblas_set_num_threads(BLAS_THREADS);
-    if (s->schur) {
-        /* H = Z~/c - Hc (x) I3 */
-        for (int a = 0; a < r; ++a)
-            for (int b = 0; b < r; ++b) {
-                double v = s->Hc[(size_t)a * r + b];
-                for (int d = 0; d < 3; ++d) s->C[(3 * (size_t)b + d) * N + 3 * (size_t)a + d] = -v;
-            }
-        add_Z(s, s->C, N, 0, 1.0);
-        info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N);
+    /* H' = (Ep (x) I3)^T (Z~/c) (Ep (x) I3) - Hc (x) I3 */
+    memset(s->Zt, 0, N3r * N3r * sizeof(double));
+    add_Z(s, s->Zt, N3r, 0, 1.0);
+    double *X = s->C; /* scratch: 3r x 3k (C is at least that large only when k >= r; use H) */
+    if (N < N3r) X = NULL;
+    double *tmp = X ? X : malloc(N3r * N * sizeof(double) + 1);
+    if (!tmp) {
         openblas_set_num_threads(blas_threads);
-        s->last_factor_s = omp_get_wtime() - t0;
-        if (info != 0)
-            return sem_error_set(err, SEM_ERR_NUMERIC,
-                                 "system matrix is not positive definite (coefficient-space pivot "
-                                 "%d): the state may have exploded or the object is not held",
-                                 (int)info);
-        return SEM_OK;
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
-    /* the whole capacitance [[F1, F2 - I], [F2^T - I, F3 - Z~/c]] (x) I3, index b 3r + 3 rho + d */
-    for (int a = 0; a < R; ++a)
-        for (int b = 0; b < R; ++b) {
-            double v = s->F[(size_t)a * R + b];
-            int ba = a >= r, bb = b >= r, ra = a - ba * r, rb = b - bb * r;
-            if (ba != bb && ra == rb) v -= 1.0;
-            if (v == 0) continue;
-            size_t ia = (size_t)ba * 3 * r + 3 * (size_t)ra, ib = (size_t)bb * 3 * r + 3 * (size_t)rb;
-            for (int d = 0; d < 3; ++d) s->C[(ib + d) * N + ia + d] = v;
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)N3r, (int)N, (int)N3r, 1.0, s->Zt, (int)N3r,
+                s->Ep3, (int)N3r, 0.0, tmp, (int)N3r);
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)N, (int)N, (int)N3r, 1.0, s->Ep3, (int)N3r, tmp,
+                (int)N3r, 0.0, s->H, (int)N);
+    if (!X) free(tmp);
+    for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+            double v = s->Hc[(size_t)a * k + b];
+            for (int d = 0; d < 3; ++d) s->H[(3 * (size_t)b + d) * N + 3 * (size_t)a + d] -= v;
         }
-    add_Z(s, s->C, N, 3 * (size_t)r, -1.0);
-    info = LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N, s->ipiv);
+    /* exactly symmetric */
+    for (size_t a = 0; a < N; ++a)
+        for (size_t b = a + 1; b < N; ++b) {
+            double v = 0.5 * (s->H[b * N + a] + s->H[a * N + b]);
+            s->H[b * N + a] = s->H[a * N + b] = v;
+        }
+    /* H' is formed by differences of terms of the error matrix's size (c = 2 gamma is
+     * large), so where A is held only by terms far below that its round-off can leave H'
+     * slightly indefinite although A is positive definite. Then H' gets the smallest
+     * diagonal shift (1e-13 of its largest diagonal, times 100 per try) that factorizes: it
+     * is the preconditioner of conjugate gradients on the exact A, which decide (a solve
+     * that meets a non-positive curvature fails as not positive definite). */
+    s->shift = 0;
+    double dmax = 0;
+    for (size_t q = 0; q < N; ++q) dmax = fmax(dmax, fabs(s->H[q * N + q]));
+    memcpy(s->C, s->H, N * N * sizeof(double));
+    lapack_int info = N > 0 ? LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N) : 0;
+    for (int t = 0; info != 0 && t < 6; ++t) {
+        s->shift = (s->shift > 0 ? 100 * s->shift : 1e-13 * dmax);
+        memcpy(s->C, s->H, N * N * sizeof(double));
+        for (size_t q = 0; q < N; ++q) s->C[q * N + q] += s->shift;
+        info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N);
+    }
+    if (getenv("SEM_DEBUG_CG")) fprintf(stderr, "H: N %zu dmax %.3g shift %.3g info %d\n", N, dmax, s->shift, (int)info);
     openblas_set_num_threads(blas_threads);
     s->last_factor_s = omp_get_wtime() - t0;
     if (info != 0)
         return sem_error_set(err, SEM_ERR_NUMERIC,
-                             "system matrix is singular (capacitance pivot %d): the state may have "
-                             "exploded or the object is not held",
+                             "system matrix is not positive definite (coefficient-space pivot %d): "
+                             "the state may have exploded or the object is not held",
                              (int)info);
-    /* inertia: positive definite exactly when half the eigenvalues are negative */
-    int neg = 0;
-    for (size_t k = 0; k < N;) {
-        double d11 = s->C[k * N + k];
-        if (s->ipiv[k] > 0) {
-            neg += d11 < 0;
-            k += 1;
-        } else {
-            double d22 = s->C[(k + 1) * N + k + 1], d21 = s->C[k * N + k + 1];
-            double det = d11 * d22 - d21 * d21;
-            neg += det < 0 ? 1 : (d11 < 0 ? 2 : 0);
-            k += 2;
-        }
-    }
-    if (neg != 3 * r)
-        return sem_error_set(err, SEM_ERR_NUMERIC,
-                             "system matrix is not positive definite (%d of %d capacitance "
-                             "eigenvalues negative): the state may have exploded or the object is "
-                             "not held",
-                             neg, 3 * r);
     return SEM_OK;
 }
 
-/* w = Cap~^-1 v in place; v = [v1; v2], 3r each (index 3 rho + d). */
+/* w = Cap^-1 v in place; v = [v1; v2], 3r each (index 3 rho + d), in the rows of P~, G~.
+ * In the basis P' = T^T P~, G' = Ep^T G~ the capacitance is [[I, B'], [B'^T, F3' - Z'/c]]:
+ * w2' = -H'^-1 (v2' - B'^T v1'), w1' = v1' - B' w2', then back: w1 = T w1', w2 = Ep w2'. */
 static void capacitance_solve(sem_structured_solver *s, double *v)
 {
-    int r = s->r;
-    lapack_int info = 0, one = 1;
+    int r = s->r, k = s->k;
+    double *v1 = v, *v2 = v + 3 * (size_t)r;
+    double *a1 = s->work + 6 * (size_t)s->o->n_ctrl + 6 * (size_t)r, *a2 = a1 + 3 * (size_t)k;
+    /* v1' = T^T v1, v2' = Ep^T v2 (r x 3 row-major blocks) */
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, 3, r, 1.0, s->T, k, v1, 3, 0.0, a1, 3);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, 3, r, 1.0, s->Ep, k, v2, 3, 0.0, a2, 3);
+    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, 3, k, -1.0, s->Bp, k, a1, 3, 1.0, a2, 3);
+    lapack_int info = 0, one = 1, N = 3 * k;
     char uplo = 'L';
-    if (!s->schur) {
-        /* LAPACK itself: LAPACKE would scan the N x N factor for NaN on every solve */
-        lapack_int N = 6 * r;
-        LAPACK_dsytrs(&uplo, &N, &one, s->C, &N, s->ipiv, v, &N, &info);
-        return;
-    }
-    double *v1 = v, *v2 = v + 3 * (size_t)r, *t = s->work + 6 * (size_t)s->o->n_ctrl + 6 * (size_t)r;
-    /* u = v2 - Y^T v1 (v as r x 3 row-major), w2 = -H^-1 u */
-    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, r, 3, r, -1.0, s->Y, r, v1, 3, 1.0, v2, 3);
-    lapack_int N3 = 3 * r;
-    LAPACK_dpotrs(&uplo, &N3, &one, s->C, &N3, v2, &N3, &info);
-    for (int k = 0; k < 3 * r; ++k) v2[k] = -v2[k];
-    /* w1 = F1^-1 (v1 - B w2), B = F2 - I: t = v1 - F2 w2 + w2 */
-    int R = 2 * r;
-    for (int a = 0; a < r; ++a)
-        for (int d = 0; d < 3; ++d) {
-            double acc = v1[3 * a + d] + v2[3 * a + d];
-            const double *f = s->F + (size_t)a * R + r;
-            for (int b = 0; b < r; ++b) acc -= f[b] * v2[3 * b + d];
-            t[(size_t)d * r + a] = acc; /* column-major r x 3 for dpotrs */
-        }
-    lapack_int rr = r, three = 3;
-    LAPACK_dpotrs(&uplo, &rr, &three, s->F1, &rr, t, &rr, &info);
-    for (int a = 0; a < r; ++a)
-        for (int d = 0; d < 3; ++d) v1[3 * a + d] = t[(size_t)d * r + a];
+    if (N > 0) LAPACK_dpotrs(&uplo, &N, &one, s->C, &N, a2, &N, &info);
+    for (int q = 0; q < 3 * k; ++q) a2[q] = -a2[q];
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, k, 3, k, -1.0, s->Bp, k, a2, 3, 1.0, a1, 3);
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, 3, k, 1.0, s->T, k, a1, 3, 0.0, v1, 3);
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, 3, k, 1.0, s->Ep, k, a2, 3, 0.0, v2, 3);
 }
 
 /* x = A^-1 b by Woodbury (to round-off of the factored form); b, x: 3n free values. */
@@ -738,7 +768,12 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
     for (it = 0; it < CG_MAX_ITERATIONS; ++it) {
         apply_A(s, p, q);
         double pq = dot(p, q, n3);
-        if (!(pq > 0)) break;
+        if (!(pq > 0)) {
+            st = sem_error_set(err, SEM_ERR_NUMERIC,
+                               "system matrix is not positive definite (a direction of non-positive "
+                               "curvature): the state may have exploded or the object is not held");
+            goto done;
+        }
         double alpha = rz / pq;
         for (size_t i = 0; i < n3; ++i) {
             x[i] += alpha * p[i];
@@ -752,6 +787,7 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
         rz = rz1;
         for (size_t i = 0; i < n3; ++i) p[i] = zz[i] + beta * p[i];
     }
+    if (getenv("SEM_DEBUG_CG")) fprintf(stderr, "cg its %d rel %.3g\n", it, rnorm / bnorm);
     if (!(rnorm <= CG_FAIL * bnorm))
         st = sem_error_set(err, SEM_ERR_NUMERIC,
                            "the structured solve did not converge (relative residual %.2g after %d "
