@@ -145,12 +145,12 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
     const double w_nnz = (double)sem_csr_nnz(&d->W) + (double)sem_csr_nnz(&d->W_samples);
 
     out->discretization = discretization_bytes(d);
-    /* the factored operators G and G' (1 + 3 rows per point, m columns per weight entry),
-     * their transposes and the products' dense accumulators (n_ctrl per thread), and the
-     * tessellation with its BVH (~1 KB per knot span at 16 x 16 cells, two triangles each) */
-    double spans = 0;
-    for (int i = 0; i < np; ++i) spans += 1; /* at least one span per part */
-    spans = spans > (double)d->n_samples / 9 ? spans : (double)d->n_samples / 9;
+    /* the factored operators G and G' (1 + 3 rows per point or sample, m columns per weight
+     * entry) and their transposes, the products' dense accumulators (n_ctrl per thread, two
+     * threads), and the tessellation with its BVH: about 32 KB per knot span (16 x 16 cells,
+     * two triangles each, ~64 bytes per triangle with the BVH), a span holding about 9
+     * samples (biquadratic) */
+    const double spans = (double)d->n_samples / 9 > np ? (double)d->n_samples / 9 : np;
     out->preprocessing = 2 * 4 * w_nnz * m * (BYTES_DOUBLE + BYTES_INT) +
                          4 * (double)d->n_ctrl * (BYTES_DOUBLE + BYTES_INT) + spans * 16 * 16 * 2 * 64;
     out->blocks = entries * (20 * BYTES_DOUBLE + 2 * BYTES_DOUBLE + BYTES_INT + 9 * BYTES_INT);
@@ -167,7 +167,6 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
                                              : (FACTOR_FILL * matrix < dense_lower ? FACTOR_FILL * matrix
                                                                                    : dense_lower);
     out->solver = matrix * 40 + 2 * factor * BYTES_DOUBLE;
-    (void)w_nnz;
     double run = out->blocks + out->assembly + out->solver;
     out->base = BASE_BYTES;
     out->total = out->base + out->discretization + (out->preprocessing > run ? out->preprocessing : run);
