@@ -213,6 +213,22 @@ typedef struct sem_world_counters {
 
 sem_world_counters sem_world_get_counters(const sem_world *world);
 
+/* Memory a run of one object needs, in bytes, estimated from its discretization's sizes
+ * (control points, parts, groups, quadrature points, samples, weights) in one cheap pass,
+ * before anything large is allocated. src/physics/memory_estimate.c explains every term. */
+typedef struct sem_memory_estimate {
+    double base;           /* the program and its libraries */
+    double discretization; /* the preprocessed data kept during the run (exact) */
+    double preprocessing;  /* what sem_preprocess holds beyond its result while it runs */
+    double blocks;         /* dense group-pair blocks of M, M_eps, K, K0 and their maps */
+    double assembly;       /* per-point and per-part-pair work of the stiffness */
+    double solver;         /* system matrix and Cholesky factor */
+    double total;          /* base + discretization + max(preprocessing, the three above):
+                              the expected peak resident memory of a run of this object */
+} sem_memory_estimate;
+sem_status sem_world_estimate_memory(const sem_discretization *disc, sem_memory_estimate *out,
+                                     sem_error *err);
+
 #ifdef __cplusplus
 }
 #endif

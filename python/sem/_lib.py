@@ -225,7 +225,8 @@ class sem_scene_world_options(Structure):
     _c_header_ = "scene.h"
     _fields_ = [("cache_dir", c_char_p), ("read_cache", c_int), ("write_cache", c_int),
                 ("cache_max_bytes", c_longlong), ("log", sem_scene_log_fn),
-                ("log_user", c_void_p), ("skip_modes", c_int)]
+                ("log_user", c_void_p), ("skip_modes", c_int),
+                ("memory_available", c_double)]
 
 
 MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,

@@ -13,7 +13,9 @@
  * linearly implicit Euler steps (gravity 9.8 m/s^2 along -z, dt 0.01, no collision), after
  * one untimed warm-up step that does the one-off work (solver choice, symbolic analysis);
  * factor = mean time of the one factorization inside those steps
- * (sem_world_last_factor_seconds); Nnz% of the q-space system matrix.
+ * (sem_world_last_factor_seconds); Nnz% of the q-space system matrix; the process's peak
+ * resident memory after the row (getrusage: the rows share one process, so a row's figure
+ * is the largest of the rows so far).
  *
  * Rows whose file is missing are skipped (with a warning). Progress goes to stderr.
  * Exit status: 0 when every available row ran; 1 when one failed or none was found.
@@ -177,9 +179,9 @@ int cmd_bench(int argc, char **argv)
         printf("Table 1: ours / paper (s) and speed-up paper / ours; %d threads; preprocessing phases "
                "the fastest of %d runs, step the mean of %d steps\n",
                omp_get_max_threads(), repeat, steps);
-        printf("%-19s %5s %5s | %-25s | %-25s | %-25s | %-25s | %-25s | %8s | %6s %6s | %8s\n", "example",
+        printf("%-19s %5s %5s | %-25s | %-25s | %-25s | %-25s | %-25s | %8s | %6s %6s | %8s | %7s\n", "example",
                "dofs", "paper", "sample", "quad", "weights", "build Pi", "step", "factor", "Nnz%",
-               "paper", "scene");
+               "paper", "scene", "peak MB");
     }
     /* Warm-up: the first preprocessing of a process pays one-off costs (Embree device,
      * thread pools, page faults) that belong to no row, and the first row used to run
@@ -246,6 +248,9 @@ int cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(o, "factor_s", b.factor_s);
             cJSON_AddNumberToObject(o, "nnz_percent", b.nnz_percent);
             cJSON_AddStringToObject(o, "solver", b.solver);
+            /* the process's peak so far: rows run one after the other in one process, so
+             * this is the largest row up to this one (docs/validation.md, section 5) */
+            cJSON_AddNumberToObject(o, "peak_memory_bytes", cli_peak_memory());
             cJSON *p = cJSON_AddObjectToObject(o, "paper");
             if (p) {
                 cJSON_AddNumberToObject(p, "dofs", r->paper_q);
@@ -263,7 +268,8 @@ int cmd_bench(int argc, char **argv)
             print_cell(b.pre.weights_s, r->paper_weights);
             print_cell(b.pre.build_pi_s, r->paper_build_pi);
             print_cell(b.step_s, r->paper_step);
-            printf(" %8.2e | %6.2f %6.2f | %8.2e\n", b.factor_s, b.nnz_percent, r->paper_nnz, b.pre.scene_s);
+            printf(" %8.2e | %6.2f %6.2f | %8.2e | %7.0f\n", b.factor_s, b.nnz_percent, r->paper_nnz,
+                   b.pre.scene_s, cli_peak_memory() / (1024.0 * 1024.0));
             fflush(stdout);
         }
     }
