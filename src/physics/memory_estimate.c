@@ -36,6 +36,13 @@
  *                   than the dense lower triangle. Counted twice: the zero-energy mode check
  *                   factors the free object while the world's own solver is made later, and
  *                   freed memory is not always returned to the system.
+ *   structured      instead of blocks and solver, when the discretization has no q-space
+ *                   operators (the structured solver, physics/structured.h): Pi over the
+ *                   control points and its reduced copy in V with G (the same size again) and
+ *                   V's transpose, the sample rows (J-hat and the coefficient rows g),
+ *                   dense coefficient matrices (Mz, Bb, Bz, F and the Schur complement with its
+ *                   scratch: about 10 (3 n_parts m)^2 doubles), S0 and its factor (about 8
+ *                   entries per J-hat entry) and the chunk of F's sparse solves.
  *   base            the program itself with its libraries (OpenBLAS buffers, Embree,
  *                   CHOLMOD, OpenMP stacks): 60 MB, measured as sem run's peak on a box.
  *
@@ -167,6 +174,15 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
                                              : (FACTOR_FILL * matrix < dense_lower ? FACTOR_FILL * matrix
                                                                                    : dense_lower);
     out->solver = matrix * 40 + 2 * factor * BYTES_DOUBLE;
+    if (sem_csr_nnz(&d->M) == 0 && d->n_ctrl > 0) {
+        /* the structured solver (see the opening comment): no q-space blocks */
+        const double r0 = (double)np * m, j_nnz = (double)sem_csr_nnz(&d->J_hat);
+        const double ws_nnz = (double)sem_csr_nnz(&d->W_samples);
+        out->blocks = 0;
+        out->solver = 5 * pi_dense * m * (BYTES_DOUBLE + BYTES_INT) + (j_nnz + ws_nnz * m) * (BYTES_DOUBLE + BYTES_INT) +
+                      10 * 9 * r0 * r0 * BYTES_DOUBLE + 8 * j_nnz * (BYTES_DOUBLE + BYTES_INT) +
+                      2 * 128 * (double)d->n_ctrl * BYTES_DOUBLE;
+    }
     double run = out->blocks + out->assembly + out->solver;
     out->base = BASE_BYTES;
     out->total = out->base + out->discretization + (out->preprocessing > run ? out->preprocessing : run);
