@@ -22,13 +22,11 @@
  *
  * and Woodbury gives A^-1 = S^-1 - S^-1 V^T Cap^-1 V S^-1 with S = c S0 and
  * Cap = Mid^-1 + V S^-1 V^T = (1/c) [[F1, F2 - I], [F2^T - I, F3 - Z/c]], F = V S0^-1 V^T.
- * S0 is factorized once (CHOLMOD, scalar, the same for x, y, z), F is computed once, and a
- * factorization of A is the symmetric indefinite factorization of the small dense Cap
- * (6 n_parts m square): nothing of size n_ctrl^2 is ever formed, and a step costs about
- * linearly in the control points (plus the cube of the coefficient count).
- * A is positive definite exactly when Cap has 3 n_parts m negative eigenvalues (Haynsworth
- * inertia additivity: S > 0 and Mid^-1 has that many of each sign), which the LDL^T pivots
- * give: the solver reports an indefinite matrix as the Cholesky solvers do.
+ * S0 is factorized once (CHOLMOD, scalar, the same for x, y, z), F is computed once, F1 is
+ * eliminated once, and a factorization of A is the Cholesky factorization of a dense
+ * coefficient-space Schur complement (at most 3 n_parts m square; structured_solver.c):
+ * nothing of size n_ctrl^2 is ever formed, and a step costs about linearly in the control
+ * points (plus the cube of the coefficient count).
  * The factored form cancels large terms (S0 against P^T G), so the direct solve is used as
  * the preconditioner of conjugate gradients on the exact products (M_eps x summed sample by
  * sample as above, never in factored form): one or two iterations reach round-off.

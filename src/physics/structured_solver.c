@@ -10,24 +10,33 @@
  * duplicates' rows summed). r = rows of P~ per coordinate.
  *
  * Schur complement. With B = F2 - I, the capacitance (times c) is [[F1, B], [B^T, F3 - Z~/c]].
- * F1 = P~ S0^-1 P~^T is constant and positive definite once the rows are distinct, so it is
- * eliminated once: what is left to factorize at each step is
+ * F1 = P~ S0^-1 P~^T is constant, block diagonal by origin group, positive semi-definite and
+ * often nearly singular (fits of one origin's parts that are nearly dependent). Each group's
+ * block, Jacobi-scaled (the rows of P~ differ in scale by powers of the model size), is
+ * decomposed into eigenpairs once; the eigenvectors above F1_CUTOFF of the group's largest
+ * eigenvalue give a basis P' = T^T P~ of P~'s row space in which F1 is the identity (the rest
+ * are exactly dependent rows: their eigenvalues sit at round-off). With Ep the matching
+ * expansion (P~ = Ep P' on the kept space) the capacitance becomes [[I, B'], [B'^T, F3' - Z'/c]]
+ * and what is left to factorize at each step is
  *
- *   H = Z~/c - (F3 - B^T F1^-1 B)        (3 r square; the constant part is precomputed)
+ *   H' = Z'/c - (F3' - B'^T B'),   Z' = Ep^T Z~ Ep   (3k square, k <= r; the constant part is
+ *                                                     precomputed, Z' is formed group pair by
+ *                                                     group pair)
  *
- * and A is positive definite exactly when H is (inertia: In(Cap) = In(F1) + In(-H), and A > 0
- * iff Cap has 3r negative eigenvalues), so H's Cholesky factorization is the test the
- * q-space Cholesky solvers make. Should F1 not be positive definite (rows of P dependent
- * beyond the repeated translations), the whole 6 r capacitance is factorized instead
- * (LDL^T, Bunch-Kaufman) and its inertia counted.
+ * A is positive definite exactly when H' is (inertia additivity: In(Cap) = In(I) + In(-H'),
+ * and A > 0 iff Cap has 3k negative eigenvalues), so H''s Cholesky factorization is the test
+ * the q-space Cholesky solvers make, up to round-off: H' is a difference of terms of the error
+ * matrix's size, so where A is held by much smaller terms a diagonal shift may be needed
+ * (see sem_structured_solver_factorize), and conjugate gradients on the exact products
+ * decide.
  *
  * Layout. Free control points f = 0..n-1 (o->free_index); dofs 3 f + d. Coefficient
  * vectors: reduced row rho, coordinate d at 3 rho + d (P~ rows; G~ rows likewise in a second
  * vector). The scalar matrices (S0, V, F) are the same for each coordinate; only Z couples
  * coordinates.
  *
- * Cost per factorization: forming H (the Kz pair blocks to the parts' own bases) and its
- * Cholesky factorization, (3r)^3 / 3 flops. Per solve: two sparse solves with S0 (3
+ * Cost per factorization: forming H' (the Kz pair blocks to the parts' own bases, then the
+ * group-pair products) and its Cholesky factorization, (3k)^3 / 3 flops. Per solve: two sparse solves with S0 (3
  * right-hand sides), products with V and V^T, small dense solves, then one or two conjugate
  * gradient iterations whose products cost O(nnz Pi + samples). Every sum runs in a fixed
  * order, and OpenBLAS uses a fixed thread count (as linear_solver.c), so the bits do not
@@ -79,7 +88,11 @@ struct sem_structured_solver {
     double *C;      /* H' (3k square), column-major, then its Cholesky factor */
     double *H;      /* H' before its factorization (for a shifted retry) */
     double *Zt;     /* 3r square: Z~/c; then 3r x 3k: Z~/c (Ep (x) I3) */
-    double *Ep3;    /* 3r x 3k column-major: Ep (x) I3 */
+    int n_groups;
+    int *grow, *grow_list; /* reduced rows of each origin group (CSR) */
+    int *gcol;      /* kept columns of each group: gcol[g] .. gcol[g + 1] */
+    double **Ep_blk; /* per group: its rows x its columns of Ep, row-major */
+    double *gscratch; /* per group pair products (see factorize) */
     double shift;   /* the diagonal shift the last factorization needed (0: none) */
     double coef[4];
     double last_factor_s;
@@ -107,7 +120,13 @@ void sem_structured_solver_destroy(sem_structured_solver *s)
     free(s->C);
     free(s->H);
     free(s->Zt);
-    free(s->Ep3);
+    if (s->Ep_blk)
+        for (int g = 0; g < s->n_groups; ++g) free(s->Ep_blk[g]);
+    free(s->Ep_blk);
+    free(s->grow);
+    free(s->grow_list);
+    free(s->gcol);
+    free(s->gscratch);
     free(s->work);
     free(s);
 }
@@ -419,25 +438,85 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
         double v = s->F[(size_t)a * R + a];
         dsq[a] = v > 0 ? sqrt(v) : 0;
     }
-    for (int a = 0; a < r; ++a)
-        for (int b = 0; b < r; ++b)
-            U[(size_t)a * r + b] = dsq[a] > 0 && dsq[b] > 0 ? s->F[(size_t)a * R + b] / (dsq[a] * dsq[b]) : 0;
-    lapack_int info = r > 0 ? LAPACKE_dsyevd(LAPACK_ROW_MAJOR, 'V', 'L', r, U, r, lam) : 0;
+    /* F1 is block diagonal by origin group (S0 by part, P~'s rows of a group over the
+     * group's control points), so each group's block is decomposed on its own: T and Ep are
+     * block diagonal too, the kept columns of group g at gcol[g] .. gcol[g + 1] */
+    const sem_object *o = s->o;
+    int ng = o->n_groups, m = o->m;
+    s->n_groups = ng;
+    s->grow = calloc((size_t)ng + 1, sizeof(int));
+    s->grow_list = malloc(((size_t)r + 1) * sizeof(int));
+    s->gcol = calloc((size_t)ng + 1, sizeof(int));
+    s->Ep_blk = calloc((size_t)ng + 1, sizeof(double *));
+    if (!s->grow || !s->grow_list || !s->gcol || !s->Ep_blk) {
+        free(U);
+        free(lam);
+        free(dsq);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int q = 0; q < r; ++q) s->grow[o->d->part_origin[s->p_first[q] / m] + 1]++;
+    for (int g = 0; g < ng; ++g) s->grow[g + 1] += s->grow[g];
+    {
+        int *fill = malloc(((size_t)ng + 1) * sizeof(int));
+        if (!fill) {
+            free(U);
+            free(lam);
+            free(dsq);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        memcpy(fill, s->grow, (size_t)ng * sizeof(int));
+        for (int q = 0; q < r; ++q) s->grow_list[fill[o->d->part_origin[s->p_first[q] / m]]++] = q;
+        free(fill);
+    }
+    /* per group: scaled block into U (row-major rg x rg), eigenvalues into lam; the kept
+     * eigenpairs are collected into Ucol / lcol (column j of the whole basis) */
+    double *Ucol = calloc(rr + 1, sizeof(double)), *lcol = malloc((size_t)r * sizeof(double) + 1);
+    int *col_row_group = malloc((size_t)r * sizeof(int) + 1);
+    if (!Ucol || !lcol || !col_row_group) {
+        free(U);
+        free(lam);
+        free(dsq);
+        free(Ucol);
+        free(lcol);
+        free(col_row_group);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    int k = 0;
+    lapack_int info = 0;
+    for (int g = 0; g < ng && info == 0; ++g) {
+        int r0g = s->grow[g], rg = s->grow[g + 1] - r0g;
+        const int *rows = s->grow_list + r0g;
+        s->gcol[g] = k;
+        if (rg == 0) continue;
+        for (int a = 0; a < rg; ++a)
+            for (int b = 0; b < rg; ++b) {
+                int qa = rows[a], qb = rows[b];
+                U[(size_t)a * rg + b] =
+                    dsq[qa] > 0 && dsq[qb] > 0 ? s->F[(size_t)qa * R + qb] / (dsq[qa] * dsq[qb]) : 0;
+            }
+        info = LAPACKE_dsyevd(LAPACK_ROW_MAJOR, 'V', 'L', rg, U, rg, lam);
+        if (info != 0) break;
+        double lmax = lam[rg - 1];
+        for (int j = 0; j < rg; ++j) {
+            if (!(lam[j] > F1_CUTOFF * lmax)) continue;
+            for (int a = 0; a < rg; ++a) Ucol[(size_t)rows[a] * r + k] = U[(size_t)a * rg + j];
+            lcol[k] = lam[j];
+            col_row_group[k] = g;
+            k++;
+        }
+    }
+    s->gcol[ng] = k;
+    (void)col_row_group;
+    free(col_row_group);
     if (info != 0) {
         free(U);
         free(lam);
         free(dsq);
+        free(Ucol);
+        free(lcol);
         return sem_error_set(err, SEM_ERR_NUMERIC, "structured solver: eigenvalues of F1 failed (%d)", (int)info);
     }
-    double lmax = r > 0 ? lam[r - 1] : 0;
-    int first = 0;
-    while (first < r && !(lam[first] > F1_CUTOFF * lmax)) first++;
-    int k = s->k = r - first;
-    if (getenv("SEM_DEBUG_CG")) {
-        fprintf(stderr, "F1 r %d lmax %.3g:", r, lmax);
-        for (int q = 0; q < r && q < 12; ++q) fprintf(stderr, " %.2g", lam[q] / lmax);
-        fprintf(stderr, "\n");
-    }
+    s->k = k;
     s->T = malloc(((size_t)r * k + 1) * sizeof(double));
     s->Ep = malloc(((size_t)r * k + 1) * sizeof(double));
     s->Bp = malloc(((size_t)k * k + 1) * sizeof(double));
@@ -448,15 +527,33 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
         free(lam);
         free(X);
         free(dsq);
+        free(Ucol);
+        free(lcol);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
-    /* eigenvectors are U's columns (row-major: U[a][j]) */
     for (int a = 0; a < r; ++a)
         for (int j = 0; j < k; ++j) {
-            double u = U[(size_t)a * r + first + j], l = lam[first + j];
+            double u = Ucol[(size_t)a * r + j], l = lcol[j];
             s->T[(size_t)a * k + j] = dsq[a] > 0 ? u / (dsq[a] * sqrt(l)) : 0;
             s->Ep[(size_t)a * k + j] = u * dsq[a] * sqrt(l);
         }
+    free(Ucol);
+    free(lcol);
+    /* each group's block of Ep (its rows x its kept columns), for forming H' */
+    for (int g = 0; g < ng; ++g) {
+        int r0g = s->grow[g], rg = s->grow[g + 1] - r0g, c0 = s->gcol[g], kg = s->gcol[g + 1] - c0;
+        s->Ep_blk[g] = malloc(((size_t)rg * kg + 1) * sizeof(double));
+        if (!s->Ep_blk[g]) {
+            free(U);
+            free(lam);
+            free(X);
+            free(dsq);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        for (int a = 0; a < rg; ++a)
+            for (int j = 0; j < kg; ++j)
+                s->Ep_blk[g][(size_t)a * kg + j] = s->Ep[(size_t)s->grow_list[r0g + a] * k + c0 + j];
+    }
     /* F2' = T^T F2 Ep: X = F2 Ep (r x k), then T^T X */
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, k, r, 1.0, s->F + r, R, s->Ep, k, 0.0, X, k);
     cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, k, r, 1.0, s->T, k, X, k, 0.0, s->Bp, k);
@@ -506,16 +603,18 @@ sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **o
         size_t N = 3 * (size_t)s->k, N3r = 3 * (size_t)s->r;
         s->C = malloc((N * N + 1) * sizeof(double));
         s->H = malloc((N * N + 1) * sizeof(double));
-        s->Zt = malloc((N3r * (N3r > N ? N3r : N) + 1) * sizeof(double));
-        s->Ep3 = calloc(N3r * N + 1, sizeof(double));
+        s->Zt = malloc((N3r * N3r + 1) * sizeof(double));
+        /* the largest group's r_g x r_h, r_g x k_h and k_g x k_h blocks */
+        size_t rmax = 1, kmax = 1;
+        for (int g = 0; g < s->n_groups; ++g) {
+            size_t rg = (size_t)(s->grow[g + 1] - s->grow[g]), kg = (size_t)(s->gcol[g + 1] - s->gcol[g]);
+            if (rg > rmax) rmax = rg;
+            if (kg > kmax) kmax = kg;
+        }
+        s->gscratch = malloc((rmax * rmax + rmax * kmax + kmax * kmax + 1) * sizeof(double));
         s->work = malloc((6 * (size_t)o->n_ctrl + 12 * (size_t)s->r + 1) * sizeof(double));
-        if (!s->C || !s->H || !s->Zt || !s->Ep3 || !s->work)
+        if (!s->C || !s->H || !s->Zt || !s->gscratch || !s->work)
             st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %zu x %zu coefficient matrix", N, N);
-        else
-            for (int a2 = 0; a2 < s->r; ++a2)
-                for (int j = 0; j < s->k; ++j)
-                    for (int d = 0; d < 3; ++d)
-                        s->Ep3[(3 * (size_t)j + d) * N3r + 3 * (size_t)a2 + d] = s->Ep[(size_t)a2 * s->k + j];
     }
     if (st != SEM_OK) {
         sem_structured_solver_destroy(s);
@@ -586,21 +685,40 @@ sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *
     size_t N = 3 * (size_t)k, N3r = 3 * (size_t)s->r;
     int blas_threads = openblas_get_num_threads();
     openblas_set_num_threads(BLAS_THREADS);
-    /* H' = (Ep (x) I3)^T (Z~/c) (Ep (x) I3) - Hc (x) I3 */
+    /* H' = (Ep (x) I3)^T (Z~/c) (Ep (x) I3) - Hc (x) I3. Ep is block diagonal by origin group
+     * and Z~ couples two groups only where their parts share a point or sample, so H' is
+     * formed block by block: H'_gh = Ep_g^T Z~_gh Ep_h per coordinate pair, for the group
+     * pairs with a non-zero block. */
     memset(s->Zt, 0, N3r * N3r * sizeof(double));
     add_Z(s, s->Zt, N3r, 0, 1.0);
-    double *X = s->C; /* scratch: 3r x 3k (C is at least that large only when k >= r; use H) */
-    if (N < N3r) X = NULL;
-    double *tmp = X ? X : malloc(N3r * N * sizeof(double) + 1);
-    if (!tmp) {
-        openblas_set_num_threads(blas_threads);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)N3r, (int)N, (int)N3r, 1.0, s->Zt, (int)N3r,
-                s->Ep3, (int)N3r, 0.0, tmp, (int)N3r);
-    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)N, (int)N, (int)N3r, 1.0, s->Ep3, (int)N3r, tmp,
-                (int)N3r, 0.0, s->H, (int)N);
-    if (!X) free(tmp);
+    memset(s->H, 0, N * N * sizeof(double));
+    for (int g = 0; g < s->n_groups; ++g)
+        for (int h = 0; h < s->n_groups; ++h) {
+            int rg = s->grow[g + 1] - s->grow[g], rh = s->grow[h + 1] - s->grow[h];
+            int kg = s->gcol[g + 1] - s->gcol[g], kh = s->gcol[h + 1] - s->gcol[h];
+            if (!rg || !rh || !kg || !kh) continue;
+            const int *rows_g = s->grow_list + s->grow[g], *rows_h = s->grow_list + s->grow[h];
+            double *Zb = s->gscratch, *Xb = Zb + (size_t)rg * rh, *Yb = Xb + (size_t)rg * kh;
+            for (int d = 0; d < 3; ++d)
+                for (int d2 = 0; d2 < 3; ++d2) {
+                    int any = 0;
+                    for (int a2 = 0; a2 < rg; ++a2)
+                        for (int b2 = 0; b2 < rh; ++b2) {
+                            double v = s->Zt[(3 * (size_t)rows_h[b2] + d2) * N3r + 3 * (size_t)rows_g[a2] + d];
+                            Zb[(size_t)a2 * rh + b2] = v;
+                            any |= v != 0;
+                        }
+                    if (!any) continue;
+                    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, rg, kh, rh, 1.0, Zb, rh, s->Ep_blk[h], kh,
+                                0.0, Xb, kh);
+                    cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, kg, kh, rg, 1.0, s->Ep_blk[g], kg, Xb, kh,
+                                0.0, Yb, kh);
+                    for (int i2 = 0; i2 < kg; ++i2)
+                        for (int j2 = 0; j2 < kh; ++j2)
+                            s->H[(3 * (size_t)(s->gcol[h] + j2) + d2) * N + 3 * (size_t)(s->gcol[g] + i2) + d] =
+                                Yb[(size_t)i2 * kh + j2];
+                }
+        }
     for (int a = 0; a < k; ++a)
         for (int b = 0; b < k; ++b) {
             double v = s->Hc[(size_t)a * k + b];
@@ -629,7 +747,6 @@ sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *
         for (size_t q = 0; q < N; ++q) s->C[q * N + q] += s->shift;
         info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)N, s->C, (lapack_int)N);
     }
-    if (getenv("SEM_DEBUG_CG")) fprintf(stderr, "H: N %zu dmax %.3g shift %.3g info %d\n", N, dmax, s->shift, (int)info);
     openblas_set_num_threads(blas_threads);
     s->last_factor_s = omp_get_wtime() - t0;
     if (info != 0)
@@ -787,7 +904,6 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
         rz = rz1;
         for (size_t i = 0; i < n3; ++i) p[i] = zz[i] + beta * p[i];
     }
-    if (getenv("SEM_DEBUG_CG")) fprintf(stderr, "cg its %d rel %.3g\n", it, rnorm / bnorm);
     if (!(rnorm <= CG_FAIL * bnorm))
         st = sem_error_set(err, SEM_ERR_NUMERIC,
                            "the structured solve did not converge (relative residual %.2g after %d "
