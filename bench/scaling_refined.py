@@ -74,7 +74,7 @@ def main():
         if k != 1:
             run([sem, "refine", src, model, "--factor", str(k)])
         lo, hi = bbox(sem, model)
-        pre = run([sem, "preprocess", model, "--json", "--no-cache"])
+        pre = run([sem, "preprocess", model, "--json", "--no-cache", "--no-modes"])
         pj = json.loads(pre)
         row = {"K": k, "dofs": pj["dofs"], "parts": pj["parts"], "samples": pj["boundary_samples"],
                "quad": pj["quadrature_points"], "pre_s": pj["timings"]["total_s"]}
