@@ -2164,7 +2164,7 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     memset(&model_curves, 0, sizeof model_curves);
     k = 5;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int crv, sense, kk, first = model_curves.n;
+        int crv, sense, kk = 0, first = model_curves.n;
         st = param_ptr(r, idx, k, 0, &crv);
         if (st == SEM_OK) st = param_int(r, idx, k + 1, &sense);
         if (st == SEM_OK) st = param_int(r, idx, k + 2, &kk);
@@ -2291,7 +2291,7 @@ static sem_status face_loop(iges_reader *r, int idx, const double *m, int depth,
      * is a collapsed edge) */
     k = 2;
     for (int i = 0; st == SEM_OK && i < n; ++i) {
-        int type, edge, index, forward, kk;
+        int type, edge, index, forward, kk = 0;
         st = param_int(r, idx, k, &type);
         if (st == SEM_OK) st = param_ptr(r, idx, k + 1, 0, &edge);
         if (st == SEM_OK) st = param_int(r, idx, k + 2, &index);
