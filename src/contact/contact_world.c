@@ -1,0 +1,663 @@
+/*
+ * contact_world.c - colliders, detection, and the contact potential of a world's system
+ * (see contact_world.h; the springs in penalty.c, friction in friction.c).
+ */
+#include "contact_world.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "collision_mesh.h"
+#include "friction.h"
+#include "penalty.h"
+
+/* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
+#define KAPPA 100.0
+#define DEFAULT_THICKNESS 1e-3     /* x L */
+#define SEARCH_DEPTH 0.25          /* x L: how deep a point may be and still be pushed out */
+#define DEFAULT_FRICTION_VELOCITY 1e-3
+#define MAX_WEIGHTS 192            /* a point's row plus a triangle's three rows */
+
+typedef struct collider {
+    sem_collider_type type;
+    double point[3], normal[3];
+    double friction;
+    int n_vertices, n_triangles;
+    double *vertices;
+    int *triangles;
+    double *face_normal;   /* unit, per triangle */
+    double *edge_normal;   /* per triangle edge (3 per triangle): sum of the faces' normals */
+    double *vertex_normal; /* angle-weighted pseudonormal (Baerentzen and Aanaes 2005) */
+    sem_bvh bvh;
+} collider;
+
+typedef struct contact_object {
+    const sem_object *object;
+    sem_collision_mesh mesh;
+    double youngs, friction, length, thickness;
+} contact_object;
+
+/* An active contact: point `point` of system object k against a collider or a triangle of
+ * system object `other`. */
+typedef struct contact_rec {
+    int k, point, other, collider, triangle;
+    double bary[3];
+    double d, n[3];          /* signed distance and its gradient */
+    double stiffness, thickness, mu;
+} contact_rec;
+
+/* A friction contact fixed at the start of a step (friction.h). */
+typedef struct friction_rec {
+    int first, count;        /* weights */
+    double T[6], X0[3], mu_lambda;
+} friction_rec;
+
+struct sem_contact {
+    sem_contact_def def;
+    int n_colliders, cap_colliders;
+    collider *colliders;
+    int n_objects, cap_objects;
+    contact_object *objects;
+    /* per evaluation */
+    int n_recs, cap_recs;
+    contact_rec *recs;
+    int *sys_to_contact;     /* system object -> contact object */
+    int n_sys;
+    double min_gap;
+    sem_point_terms terms;   /* Hessian of the last sem_contact_potential with a gradient */
+    sem_point_terms friction_terms;
+    /* friction of the current step */
+    int n_friction, cap_friction;
+    friction_rec *friction;
+    int n_fweights, cap_fweights;
+    sem_point_weight *fweights;
+    double friction_eps;     /* eps_v h of the step; 0: no friction */
+    sem_contact_stats stats;
+};
+
+/* ---------------------------------------------------------------------------------- */
+/* life cycle                                                                          */
+
+sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem_error *err)
+{
+    *out = NULL;
+    if (!isfinite(def->stiffness) || !isfinite(def->thickness) || !isfinite(def->friction_velocity))
+        return sem_error_set(err, SEM_ERR_INVALID, "contact settings must be finite");
+    if (def->self) return sem_error_set(err, SEM_ERR_INVALID, "contact: self-contact is not implemented yet");
+    if (def->resolution > 64)
+        return sem_error_set(err, SEM_ERR_INVALID, "contact resolution must be at most 64 (got %d)", def->resolution);
+    sem_contact *c = calloc(1, sizeof *c);
+    if (!c) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    c->def = *def;
+    if (!(c->def.friction_velocity > 0)) c->def.friction_velocity = DEFAULT_FRICTION_VELOCITY;
+    c->stats.min_gap = INFINITY;
+    sem_point_terms_init(&c->terms);
+    sem_point_terms_init(&c->friction_terms);
+    *out = c;
+    return SEM_OK;
+}
+
+static void collider_free(collider *k)
+{
+    free(k->vertices);
+    free(k->triangles);
+    free(k->face_normal);
+    free(k->edge_normal);
+    free(k->vertex_normal);
+    sem_bvh_free(&k->bvh);
+}
+
+void sem_contact_destroy(sem_contact *c)
+{
+    if (!c) return;
+    for (int i = 0; i < c->n_colliders; ++i) collider_free(&c->colliders[i]);
+    for (int i = 0; i < c->n_objects; ++i) sem_collision_mesh_free(&c->objects[i].mesh);
+    free(c->colliders);
+    free(c->objects);
+    free(c->recs);
+    free(c->sys_to_contact);
+    free(c->friction);
+    free(c->fweights);
+    sem_point_terms_free(&c->terms);
+    sem_point_terms_free(&c->friction_terms);
+    free(c);
+}
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void normalize3(double a[3])
+{
+    double l = sqrt(dot3(a, a));
+    if (l > 0)
+        for (int k = 0; k < 3; ++k) a[k] /= l;
+}
+
+typedef struct edge_key {
+    int a, b, slot; /* vertices a < b; slot = 3 triangle + edge */
+} edge_key;
+
+static int compare_edge(const void *x, const void *y)
+{
+    const edge_key *p = x, *q = y;
+    if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
+    if (p->b != q->b) return (p->b > q->b) - (p->b < q->b);
+    return (p->slot > q->slot) - (p->slot < q->slot);
+}
+
+/* Face, edge and vertex pseudonormals of a collider mesh: the sign of the distance to a
+ * closed (or terrain-like) mesh is that of (p - c) . pseudonormal at the closest feature. */
+static sem_status mesh_normals(collider *k, sem_error *err)
+{
+    size_t nt = (size_t)k->n_triangles;
+    k->face_normal = calloc(3 * nt + 1, sizeof(double));
+    k->edge_normal = calloc(9 * nt + 1, sizeof(double));
+    k->vertex_normal = calloc(3 * (size_t)k->n_vertices + 1, sizeof(double));
+    edge_key *edges = malloc((3 * nt + 1) * sizeof *edges);
+    if (!k->face_normal || !k->edge_normal || !k->vertex_normal || !edges) {
+        free(edges);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collider");
+    }
+    for (size_t t = 0; t < nt; ++t) {
+        const int *tri = k->triangles + 3 * t;
+        double *n = k->face_normal + 3 * t;
+        const double *x[3] = {k->vertices + 3 * (size_t)tri[0], k->vertices + 3 * (size_t)tri[1],
+                              k->vertices + 3 * (size_t)tri[2]};
+        double e1[3], e2[3];
+        for (int d = 0; d < 3; ++d) {
+            e1[d] = x[1][d] - x[0][d];
+            e2[d] = x[2][d] - x[0][d];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        normalize3(n);
+        for (int v = 0; v < 3; ++v) {
+            /* the triangle's angle at vertex v */
+            double a[3], b[3];
+            for (int d = 0; d < 3; ++d) {
+                a[d] = x[(v + 1) % 3][d] - x[v][d];
+                b[d] = x[(v + 2) % 3][d] - x[v][d];
+            }
+            normalize3(a);
+            normalize3(b);
+            double cosang = dot3(a, b);
+            double angle = acos(cosang < -1 ? -1 : cosang > 1 ? 1 : cosang);
+            for (int d = 0; d < 3; ++d) k->vertex_normal[3 * (size_t)tri[v] + d] += angle * n[d];
+            int p = tri[v], q = tri[(v + 1) % 3];
+            edges[3 * t + (size_t)v] = (edge_key){p < q ? p : q, p < q ? q : p, (int)(3 * t) + v};
+        }
+    }
+    qsort(edges, 3 * nt, sizeof *edges, compare_edge);
+    for (size_t i = 0; i < 3 * nt;) {
+        size_t j = i;
+        double sum[3] = {0, 0, 0};
+        while (j < 3 * nt && edges[j].a == edges[i].a && edges[j].b == edges[i].b) {
+            const double *n = k->face_normal + 3 * (size_t)(edges[j].slot / 3);
+            for (int d = 0; d < 3; ++d) sum[d] += n[d];
+            ++j;
+        }
+        normalize3(sum);
+        for (size_t e = i; e < j; ++e) memcpy(k->edge_normal + 3 * (size_t)edges[e].slot, sum, sizeof sum);
+        i = j;
+    }
+    for (int v = 0; v < k->n_vertices; ++v) normalize3(k->vertex_normal + 3 * (size_t)v);
+    free(edges);
+    return SEM_OK;
+}
+
+sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def, sem_error *err)
+{
+    if (!(def->friction >= 0) || !isfinite(def->friction))
+        return sem_error_set(err, SEM_ERR_INVALID, "collider friction must be >= 0 (got %g)", def->friction);
+    collider k;
+    memset(&k, 0, sizeof k);
+    k.type = def->type;
+    k.friction = def->friction;
+    if (def->type == SEM_COLLIDER_PLANE) {
+        memcpy(k.point, def->point, sizeof k.point);
+        memcpy(k.normal, def->normal, sizeof k.normal);
+        double l = sqrt(dot3(k.normal, k.normal));
+        if (!(l > 0) || !isfinite(l)) return sem_error_set(err, SEM_ERR_INVALID, "plane normal must be non-zero");
+        for (int d = 0; d < 3; ++d) {
+            k.normal[d] /= l;
+            if (!isfinite(k.point[d])) return sem_error_set(err, SEM_ERR_INVALID, "plane point must be finite");
+        }
+    } else if (def->type == SEM_COLLIDER_MESH) {
+        if (def->n_triangles <= 0 || def->n_vertices <= 0 || !def->vertices || !def->triangles)
+            return sem_error_set(err, SEM_ERR_INVALID, "collider mesh has no triangle");
+        for (int t = 0; t < 3 * def->n_triangles; ++t)
+            if (def->triangles[t] < 0 || def->triangles[t] >= def->n_vertices)
+                return sem_error_set(err, SEM_ERR_INVALID, "collider mesh triangle %d has a vertex index out of range",
+                                     t / 3);
+        for (int v = 0; v < 3 * def->n_vertices; ++v)
+            if (!isfinite(def->vertices[v]))
+                return sem_error_set(err, SEM_ERR_INVALID, "collider mesh vertex %d is not finite", v / 3);
+        k.n_vertices = def->n_vertices;
+        k.n_triangles = def->n_triangles;
+        k.vertices = malloc(3 * (size_t)k.n_vertices * sizeof(double));
+        k.triangles = malloc(3 * (size_t)k.n_triangles * sizeof(int));
+        if (!k.vertices || !k.triangles) {
+            collider_free(&k);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collider");
+        }
+        memcpy(k.vertices, def->vertices, 3 * (size_t)k.n_vertices * sizeof(double));
+        memcpy(k.triangles, def->triangles, 3 * (size_t)k.n_triangles * sizeof(int));
+        sem_status st = mesh_normals(&k, err);
+        if (st == SEM_OK) st = sem_bvh_build(&k.bvh, k.vertices, k.triangles, k.n_triangles, err);
+        if (st != SEM_OK) {
+            collider_free(&k);
+            return st;
+        }
+    } else
+        return sem_error_set(err, SEM_ERR_INVALID, "unknown collider type %d", (int)def->type);
+    if (c->n_colliders == c->cap_colliders) {
+        int cap = c->cap_colliders ? 2 * c->cap_colliders : 4;
+        collider *x = realloc(c->colliders, (size_t)cap * sizeof *x);
+        if (!x) {
+            collider_free(&k);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        c->colliders = x;
+        c->cap_colliders = cap;
+    }
+    c->colliders[c->n_colliders++] = k;
+    c->stats.colliders = c->n_colliders;
+    return SEM_OK;
+}
+
+sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error *err)
+{
+    if (c->n_objects == c->cap_objects) {
+        int cap = c->cap_objects ? 2 * c->cap_objects : 4;
+        contact_object *x = realloc(c->objects, (size_t)cap * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        c->objects = x;
+        c->cap_objects = cap;
+    }
+    contact_object *co = &c->objects[c->n_objects];
+    memset(co, 0, sizeof *co);
+    co->object = o;
+    if (c->def.disabled) {
+        /* no contact at all: no mesh (a mesh of zero points) */
+        c->n_objects++;
+        return SEM_OK;
+    }
+    sem_status st = sem_collision_mesh_build(o->def.model, c->def.resolution, &co->mesh, err);
+    if (st != SEM_OK) return st;
+    co->youngs = o->def.material.youngs_modulus;
+    co->friction = o->def.friction;
+    co->length = co->mesh.length > 0 ? co->mesh.length : 1.0;
+    co->thickness = c->def.thickness > 0 ? c->def.thickness : DEFAULT_THICKNESS * co->length;
+    c->n_objects++;
+    return SEM_OK;
+}
+
+void sem_contact_remove_last_object(sem_contact *c)
+{
+    if (c->n_objects > 0) sem_collision_mesh_free(&c->objects[--c->n_objects].mesh);
+}
+
+int sem_contact_between_objects(const sem_contact *c) { return !c->def.disabled && c->n_objects >= 2; }
+
+int sem_contact_active(const sem_contact *c)
+{
+    return !c->def.disabled && (c->n_colliders > 0 || c->n_objects >= 2);
+}
+
+const sem_point_terms *sem_contact_terms(const sem_contact *c) { return &c->terms; }
+
+void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out) { *out = c->stats; }
+
+/* ---------------------------------------------------------------------------------- */
+/* detection                                                                           */
+
+/* contact_object of each of the system's objects */
+static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err)
+{
+    if (c->n_sys < s->n_objects) {
+        int *x = realloc(c->sys_to_contact, (size_t)s->n_objects * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        c->sys_to_contact = x;
+    }
+    c->n_sys = s->n_objects;
+    for (int k = 0; k < s->n_objects; ++k) {
+        c->sys_to_contact[k] = -1;
+        for (int i = 0; i < c->n_objects; ++i)
+            if (c->objects[i].object == s->objects[k]) c->sys_to_contact[k] = i;
+        if (c->sys_to_contact[k] < 0)
+            return sem_error_set(err, SEM_ERR_INVALID, "contact: an object of the system is not in the world");
+    }
+    return SEM_OK;
+}
+
+static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
+{
+    if (c->n_recs == c->cap_recs) {
+        int cap = c->cap_recs ? 2 * c->cap_recs : 256;
+        contact_rec *x = realloc(c->recs, (size_t)cap * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+        c->recs = x;
+        c->cap_recs = cap;
+    }
+    c->recs[c->n_recs++] = *r;
+    return SEM_OK;
+}
+
+/* Every active contact at the system's vector q into c->recs, and c->min_gap. */
+static sem_status detect(sem_contact *c, const sem_system *s, const double *q, sem_error *err)
+{
+    sem_status st = map_system(c, s, err);
+    if (st != SEM_OK) return st;
+    c->n_recs = 0;
+    c->min_gap = INFINITY;
+    if (c->def.disabled) return SEM_OK;
+    int between = s->n_objects >= 2;
+    for (int k = 0; k < s->n_objects; ++k)
+        sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
+    for (int k = 0; k < s->n_objects; ++k) {
+        const contact_object *co = &c->objects[c->sys_to_contact[k]];
+        const sem_collision_mesh *m = &co->mesh;
+        double th = co->thickness, L = co->length;
+        double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
+        double radius = th + SEARCH_DEPTH * L;
+        for (int p = 0; p < m->n_points; ++p) {
+            if (!(m->area[p] > 0)) continue;
+            const double *x = m->x + 3 * (size_t)p;
+            for (int i = 0; i < c->n_colliders; ++i) {
+                const collider *col = &c->colliders[i];
+                contact_rec r = {k, p, -1, i, -1, {0, 0, 0}, 0, {0, 0, 0}, 0, th, 0};
+                if (col->type == SEM_COLLIDER_PLANE) {
+                    double diff[3] = {x[0] - col->point[0], x[1] - col->point[1], x[2] - col->point[2]};
+                    r.d = dot3(diff, col->normal);
+                    memcpy(r.n, col->normal, sizeof r.n);
+                } else {
+                    sem_tri_closest cl;
+                    int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, radius * radius, &cl);
+                    if (t < 0) continue;
+                    const double *outward = cl.feature == SEM_TRI_FACE   ? col->face_normal + 3 * (size_t)t
+                                            : cl.feature == SEM_TRI_EDGE ? col->edge_normal + 9 * (size_t)t + 3 * cl.index
+                                                                         : col->vertex_normal +
+                                                                               3 * (size_t)col->triangles[3 * t + cl.index];
+                    r.d = sem_signed_distance(x, cl.point, outward, r.n);
+                }
+                if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
+                if (!(r.d < th)) continue;
+                r.stiffness = own_stiffness * m->area[p];
+                r.mu = sqrt(co->friction * col->friction);
+                if ((st = push_rec(c, &r, err)) != SEM_OK) return st;
+            }
+            if (!between) continue;
+            for (int j = 0; j < s->n_objects; ++j) {
+                if (j == k) continue;
+                const contact_object *cj = &c->objects[c->sys_to_contact[j]];
+                const sem_collision_mesh *mj = &cj->mesh;
+                sem_tri_closest cl;
+                int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, radius * radius, &cl);
+                if (t < 0) continue;
+                contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
+                const int *tri = mj->triangles + 3 * t;
+                double outward[3] = {0, 0, 0};
+                if (cl.feature == SEM_TRI_FACE) {
+                    const double *a = mj->x + 3 * (size_t)tri[0], *b = mj->x + 3 * (size_t)tri[1],
+                                 *cc = mj->x + 3 * (size_t)tri[2];
+                    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+                    double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+                    outward[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                    outward[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                    outward[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                } else
+                    for (int v = 0; v < 3; ++v)
+                        if (cl.bary[v] > 0)
+                            for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
+                r.d = sem_signed_distance(x, cl.point, outward, r.n);
+                if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
+                if (!(r.d < th)) continue;
+                double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
+                r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
+                r.mu = sqrt(co->friction * cj->friction);
+                if ((st = push_rec(c, &r, err)) != SEM_OK) return st;
+            }
+        }
+    }
+    return SEM_OK;
+}
+
+/* The weights of a contact's relative point: its point's row (+phi), and for a contact
+ * with another object that object's triangle rows (-bary phi). Returns the count. */
+static int rec_weights(const sem_contact *c, const contact_rec *r, sem_point_weight *w)
+{
+    const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
+    int n = 0;
+    for (int e = m->row_start[r->point]; e < m->row_start[r->point + 1] && n < MAX_WEIGHTS; ++e)
+        w[n++] = (sem_point_weight){r->k, m->row_ctrl[e], m->row_w[e]};
+    if (r->other >= 0) {
+        const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
+        for (int v = 0; v < 3; ++v) {
+            if (r->bary[v] == 0) continue;
+            int p = mo->triangles[3 * r->triangle + v];
+            for (int e = mo->row_start[p]; e < mo->row_start[p + 1] && n < MAX_WEIGHTS; ++e)
+                w[n++] = (sem_point_weight){r->other, mo->row_ctrl[e], -r->bary[v] * mo->row_w[e]};
+        }
+    }
+    return n;
+}
+
+static void add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad)
+{
+    for (int i = 0; i < n; ++i) {
+        double *g = grad + s->dof_offset[w[i].object] + 3 * (size_t)w[i].ctrl;
+        for (int d = 0; d < 3; ++d) g[d] += w[i].w * f[d];
+    }
+}
+
+static void relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
+{
+    X[0] = X[1] = X[2] = 0;
+    for (int i = 0; i < n; ++i) {
+        const double *x = q + s->dof_offset[w[i].object] + 3 * (size_t)w[i].ctrl;
+        for (int d = 0; d < 3; ++d) X[d] += w[i].w * x[d];
+    }
+}
+
+/* Springs at the last detection: energy; gradient into grad and Hessian into terms when
+ * grad is given. */
+static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem_point_terms *terms, double *energy,
+                          sem_error *err)
+{
+    sem_point_weight w[MAX_WEIGHTS];
+    double E = 0;
+    for (int i = 0; i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        double slope;
+        E += sem_penalty_energy(r->stiffness, r->d, r->thickness, &slope);
+        if (!grad) continue;
+        int n = rec_weights(c, r, w);
+        double f[3] = {slope * r->n[0], slope * r->n[1], slope * r->n[2]};
+        add_gradient(s, w, n, f, grad);
+        double H[9] = {0};
+        sem_penalty_hessian(r->stiffness, r->n, H);
+        sem_status st = sem_point_terms_push(terms, w, n, H, err);
+        if (st != SEM_OK) return st;
+    }
+    *energy = E;
+    return SEM_OK;
+}
+
+/* Friction of the step at q: energy; gradient and Hessian terms when grad is given. */
+static sem_status friction(sem_contact *c, const sem_system *s, const double *q, double *grad,
+                           sem_point_terms *terms, double *energy, sem_error *err)
+{
+    double E = 0;
+    if (!(c->friction_eps > 0)) {
+        *energy = 0;
+        return SEM_OK;
+    }
+    for (int i = 0; i < c->n_friction; ++i) {
+        const friction_rec *fr = &c->friction[i];
+        const sem_point_weight *w = c->fweights + fr->first;
+        double X[3], u[2], g[2], Hu[4];
+        relative_point(s, w, fr->count, q, X);
+        for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
+        u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
+        u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
+        E += sem_friction_potential(fr->mu_lambda, u, c->friction_eps, grad ? g : NULL, grad ? Hu : NULL);
+        if (!grad) continue;
+        double f[3], H[9];
+        for (int a = 0; a < 3; ++a) {
+            f[a] = fr->T[2 * a] * g[0] + fr->T[2 * a + 1] * g[1];
+            for (int b = 0; b < 3; ++b) {
+                /* T Hu T^T */
+                double ta0 = fr->T[2 * a], ta1 = fr->T[2 * a + 1], tb0 = fr->T[2 * b], tb1 = fr->T[2 * b + 1];
+                H[3 * a + b] = ta0 * (Hu[0] * tb0 + Hu[1] * tb1) + ta1 * (Hu[2] * tb0 + Hu[3] * tb1);
+            }
+        }
+        add_gradient(s, w, fr->count, f, grad);
+        sem_status st = sem_point_terms_push(terms, w, fr->count, H, err);
+        if (st != SEM_OK) return st;
+    }
+    *energy = E;
+    return SEM_OK;
+}
+
+/* The system's objects' a q + b v as one vector (the caller frees). */
+static double *system_q(const sem_system *s, double a, double b)
+{
+    double *q = malloc(s->n_dofs * sizeof(double) + 1);
+    if (!q) return NULL;
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        double *x = q + s->dof_offset[k];
+        for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) x[i] = a * o->q[i] + b * o->v[i];
+    }
+    return q;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* the step                                                                            */
+
+sem_status sem_contact_begin_step(sem_contact *c, const sem_system *s, double h, sem_error *err)
+{
+    c->stats.seconds = 0;
+    c->n_friction = 0;
+    c->n_fweights = 0;
+    c->friction_eps = 0;
+    if (!sem_contact_active(c)) return SEM_OK;
+    double t0 = omp_get_wtime();
+    double *q = system_q(s, 1, 0);
+    if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_status st = detect(c, s, q, err);
+    c->friction_eps = h > 0 ? c->def.friction_velocity * h : 0;
+    sem_point_weight w[MAX_WEIGHTS];
+    for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        double lambda = r->stiffness * (r->thickness - r->d);
+        if (!(r->mu > 0) || !(lambda > 0)) continue;
+        int n = rec_weights(c, r, w);
+        if (c->n_friction == c->cap_friction) {
+            int cap = c->cap_friction ? 2 * c->cap_friction : 256;
+            friction_rec *x = realloc(c->friction, (size_t)cap * sizeof *x);
+            if (!x) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+                break;
+            }
+            c->friction = x;
+            c->cap_friction = cap;
+        }
+        if (c->n_fweights + n > c->cap_fweights) {
+            int cap = c->cap_fweights ? 2 * c->cap_fweights : 4096;
+            while (cap < c->n_fweights + n) cap *= 2;
+            sem_point_weight *x = realloc(c->fweights, (size_t)cap * sizeof *x);
+            if (!x) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+                break;
+            }
+            c->fweights = x;
+            c->cap_fweights = cap;
+        }
+        friction_rec *fr = &c->friction[c->n_friction++];
+        fr->first = c->n_fweights;
+        fr->count = n;
+        memcpy(c->fweights + c->n_fweights, w, (size_t)n * sizeof *w);
+        c->n_fweights += n;
+        sem_tangent_basis(r->n, fr->T);
+        relative_point(s, w, n, q, fr->X0);
+        fr->mu_lambda = r->mu * lambda;
+    }
+    free(q);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st;
+}
+
+double sem_contact_potential(sem_contact *c, const sem_system *s, const double *q, double h, double *grad,
+                             sem_error *err)
+{
+    if (grad) sem_point_terms_clear(&c->terms);
+    if (!sem_contact_active(c)) return 0;
+    double t0 = omp_get_wtime();
+    double Es = 0, Ef = 0;
+    sem_status st = detect(c, s, q, err);
+    if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, err);
+    if (st == SEM_OK && h > 0) st = friction(c, s, q, grad, &c->terms, &Ef, err);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st == SEM_OK ? Es + Ef : NAN;
+}
+
+sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, double *rhs, sem_error *err)
+{
+    if (!sem_contact_active(c)) return SEM_OK;
+    double t0 = omp_get_wtime();
+    sem_status st = SEM_OK;
+    double *q = system_q(s, 1, 0), *qpred = system_q(s, 1, h), *v = system_q(s, 0, 1);
+    double *g = calloc(s->n_dofs + 1, sizeof(double));
+    double E;
+    if (!q || !qpred || !v || !g) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    /* springs at q_n (as the elastic forces): h^2 H in the matrix, h f on the right */
+    sem_point_terms_clear(&c->terms);
+    if ((st = detect(c, s, q, err)) != SEM_OK) goto done;
+    if ((st = springs(c, s, g, &c->terms, &E, err)) != SEM_OK) goto done;
+    sem_system_add_point_terms(s, &c->terms, h * h);
+    /* friction linearized about v_n: its force at q_n + h v_n, and h^2 H (v+ - v_n) */
+    sem_point_terms_clear(&c->friction_terms);
+    if ((st = friction(c, s, qpred, g, &c->friction_terms, &E, err)) != SEM_OK) goto done;
+    sem_system_add_point_terms(s, &c->friction_terms, h * h);
+    for (size_t i = 0; i < s->n_dofs; ++i) rhs[i] -= h * g[i];
+    sem_point_terms_multiply(s, &c->friction_terms, h * h, v, rhs);
+done:
+    free(q);
+    free(qpred);
+    free(v);
+    free(g);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st;
+}
+
+void sem_contact_end_step(sem_contact *c, const sem_system *s)
+{
+    c->stats.contacts = 0;
+    c->stats.min_gap = INFINITY;
+    if (!sem_contact_active(c)) return;
+    double t0 = omp_get_wtime();
+    double *q = system_q(s, 1, 0);
+    sem_error err;
+    if (q && detect(c, s, q, &err) == SEM_OK) {
+        c->stats.contacts = c->n_recs;
+        c->stats.min_gap = c->min_gap;
+    }
+    free(q);
+    c->stats.seconds += omp_get_wtime() - t0;
+}
+
+sem_collider_def sem_default_collider_def(void)
+{
+    sem_collider_def d;
+    memset(&d, 0, sizeof d);
+    d.type = SEM_COLLIDER_PLANE;
+    d.normal[2] = 1;
+    d.friction = SEM_DEFAULT_FRICTION;
+    return d;
+}
