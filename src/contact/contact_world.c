@@ -14,7 +14,7 @@
 #include "penalty.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
-#define KAPPA 100.0
+#define KAPPA 1000.0
 #define DEFAULT_THICKNESS 1e-3     /* x L */
 #define SEARCH_DEPTH 0.25          /* x L: how deep a point may be and still be pushed out */
 #define DEFAULT_FRICTION_VELOCITY 1e-3
@@ -345,8 +345,9 @@ static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
     return SEM_OK;
 }
 
-/* Every active contact at the system's vector q into c->recs, and c->min_gap. */
-static sem_status detect(sem_contact *c, const sem_system *s, const double *q, sem_error *err)
+/* Every contact at the system's vector q closer than thickness + margin x (the search
+ * radius) into c->recs (margin 0: the active ones), and c->min_gap. */
+static sem_status detect(sem_contact *c, const sem_system *s, const double *q, double margin, sem_error *err)
 {
     sem_status st = map_system(c, s, err);
     if (st != SEM_OK) return st;
@@ -383,7 +384,7 @@ static sem_status detect(sem_contact *c, const sem_system *s, const double *q, s
                     r.d = sem_signed_distance(x, cl.point, outward, r.n);
                 }
                 if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
-                if (!(r.d < th)) continue;
+                if (!(r.d < th + margin * radius)) continue;
                 r.stiffness = own_stiffness * m->area[p];
                 r.mu = sqrt(co->friction * col->friction);
                 if ((st = push_rec(c, &r, err)) != SEM_OK) return st;
@@ -413,7 +414,7 @@ static sem_status detect(sem_contact *c, const sem_system *s, const double *q, s
                             for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
                 r.d = sem_signed_distance(x, cl.point, outward, r.n);
                 if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
-                if (!(r.d < th)) continue;
+                if (!(r.d < th + margin * radius)) continue;
                 double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
                 r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
                 r.mu = sqrt(co->friction * cj->friction);
@@ -462,9 +463,13 @@ static void relative_point(const sem_system *s, const sem_point_weight *w, int n
 }
 
 /* Springs at the last detection: energy; gradient into grad and Hessian into terms when
- * grad is given. */
+ * grad is given. With v (the linearly implicit step's velocities, h its step), a contact
+ * not active yet but predicted to be at q + h v is a speculative one: its spring is the
+ * linear extension of the active one (a pull towards the surface, to be reached within
+ * the step; Box2D's speculative contacts), so a fast point stops at the surface instead of
+ * sinking in for a step and being thrown out by a stiff spring the next. */
 static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem_point_terms *terms, double *energy,
-                          sem_error *err)
+                          const double *v, double h, sem_error *err)
 {
     sem_point_weight w[MAX_WEIGHTS];
     double E = 0;
@@ -472,8 +477,17 @@ static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem
         const contact_rec *r = &c->recs[i];
         double slope;
         E += sem_penalty_energy(r->stiffness, r->d, r->thickness, &slope);
+        int n = 0;
+        if (v && !(r->d < r->thickness)) {
+            double X[3];
+            n = rec_weights(c, r, w);
+            relative_point(s, w, n, v, X);
+            if (!(r->d + h * dot3(X, r->n) < r->thickness)) continue;
+            slope = r->stiffness * (r->d - r->thickness);
+        } else if (!(r->d < r->thickness))
+            continue;
         if (!grad) continue;
-        int n = rec_weights(c, r, w);
+        if (n == 0) n = rec_weights(c, r, w);
         double f[3] = {slope * r->n[0], slope * r->n[1], slope * r->n[2]};
         add_gradient(s, w, n, f, grad);
         double H[9] = {0};
@@ -547,7 +561,7 @@ sem_status sem_contact_begin_step(sem_contact *c, const sem_system *s, double h,
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    sem_status st = detect(c, s, q, err);
+    sem_status st = detect(c, s, q, 0, err);
     c->friction_eps = h > 0 ? c->def.friction_velocity * h : 0;
     sem_point_weight w[MAX_WEIGHTS];
     for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < c->n_recs; ++i) {
@@ -597,8 +611,8 @@ double sem_contact_potential(sem_contact *c, const sem_system *s, const double *
     if (!sem_contact_active(c)) return 0;
     double t0 = omp_get_wtime();
     double Es = 0, Ef = 0;
-    sem_status st = detect(c, s, q, err);
-    if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, err);
+    sem_status st = detect(c, s, q, 0, err);
+    if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, NULL, 0, err);
     if (st == SEM_OK && h > 0) st = friction(c, s, q, grad, &c->terms, &Ef, err);
     c->stats.seconds += omp_get_wtime() - t0;
     return st == SEM_OK ? Es + Ef : NAN;
@@ -618,8 +632,8 @@ sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, doubl
     }
     /* springs at q_n (as the elastic forces): h^2 H in the matrix, h f on the right */
     sem_point_terms_clear(&c->terms);
-    if ((st = detect(c, s, q, err)) != SEM_OK) goto done;
-    if ((st = springs(c, s, g, &c->terms, &E, err)) != SEM_OK) goto done;
+    if ((st = detect(c, s, q, 1, err)) != SEM_OK) goto done;
+    if ((st = springs(c, s, g, &c->terms, &E, v, h, err)) != SEM_OK) goto done;
     sem_system_add_point_terms(s, &c->terms, h * h);
     /* friction linearized about v_n: its force at q_n + h v_n, and h^2 H (v+ - v_n) */
     sem_point_terms_clear(&c->friction_terms);
@@ -644,7 +658,7 @@ void sem_contact_end_step(sem_contact *c, const sem_system *s)
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     sem_error err;
-    if (q && detect(c, s, q, &err) == SEM_OK) {
+    if (q && detect(c, s, q, 0, &err) == SEM_OK) {
         c->stats.contacts = c->n_recs;
         c->stats.min_gap = c->min_gap;
     }

@@ -232,9 +232,30 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     od.n_point_loads = so->n_point_loads;
     od.region_loads = so->region_loads;
     od.n_region_loads = so->n_region_loads;
+    od.friction = so->friction;
     int id = sem_world_add_object(sw->world, &od, err);
     if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
     return o->skip_modes ? SEM_OK : check_modes(sw, i, id, o, err);
+}
+
+/* The scene's collider i into the world. */
+static sem_status add_collider(sem_scene_world *sw, int i, sem_error *err)
+{
+    sem_collider_def def;
+    double *vertices = NULL;
+    int *triangles = NULL;
+    sem_status st = sem_scene_collider_def(sw->scene, i, &def, &vertices, &triangles, err);
+    if (st == SEM_OK && sem_world_add_collider(sw->world, &def, err) < 0) {
+        st = err ? err->status : SEM_ERR_INVALID;
+        if (err) {
+            char msg[sizeof err->message];
+            snprintf(msg, sizeof msg, "%s", err->message);
+            sem_error_set(err, st, "%s: colliders[%d]: %s", sw->scene->path[0] ? sw->scene->path : "scene", i, msg);
+        }
+    }
+    free(vertices);
+    free(triangles);
+    return st;
 }
 
 sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_options *options,
@@ -276,6 +297,9 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
         }
         goto fail;
     }
+    /* static colliders first: a bad one fails before any preprocessing */
+    for (int i = 0; i < scene->n_colliders; ++i)
+        if ((st = add_collider(sw, i, err)) != SEM_OK) goto fail;
     sw->all_cached = 1;
     double t0 = omp_get_wtime();
     for (int i = 0; i < sw->n; ++i)

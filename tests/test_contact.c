@@ -1,0 +1,273 @@
+/* test_contact.c - contact and friction (issue 13): a rubber box dropped on a plane comes to
+ * rest at the right height without sinking in, a box on a 30-degree incline sticks with
+ * mu = 0.8 and slides with a = g (sin 30 - mu cos 30) with mu = 0.2, a sphere dropped into a
+ * V-shaped triangle-mesh valley settles at its bottom; colliders and contact settings from
+ * scene files, and their errors. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sem/preprocess.h"
+#include "sem/primitives.h"
+#include "sem/scene.h"
+#include "sem/simulation.h"
+#include "test_util.h"
+
+#define G 9.81
+
+typedef struct setup {
+    sem_model *model;
+    sem_discretization *disc;
+    sem_world *world;
+} setup;
+
+static void setup_free(setup *s)
+{
+    sem_world_destroy(s->world);
+    sem_discretization_destroy(s->disc);
+    sem_model_destroy(s->model);
+    memset(s, 0, sizeof *s);
+}
+
+/* A rubber solid (rho 1000, E 1e6, nu 0.45), coarsely preprocessed (4 x 4 rays: the contact
+ * numbers do not depend on the quadrature's resolution), in a world with the given gravity
+ * and integrator, with friction mu on the object. sphere: radius 0.5 at center, else a 1 m
+ * box. */
+static int make(setup *s, int sphere, const double center[3], const double gravity[3], sem_integrator integ,
+                double mu)
+{
+    memset(s, 0, sizeof *s);
+    sem_error err;
+    s->model = sem_model_create();
+    sem_status st;
+    if (sphere) {
+        sem_sphere_def sd = sem_default_sphere_def();
+        sd.radius = 0.5;
+        st = sem_primitive_sphere(s->model, &sd, &err);
+        for (size_t c = 0; st == SEM_OK && c < (size_t)s->model->parts[0].surface.n_u * s->model->parts[0].surface.n_v; ++c)
+            for (int k = 0; k < 3; ++k) s->model->parts[0].surface.ctrl[3 * c + k] += center[k];
+    } else {
+        sem_box_def bd = sem_default_box_def();
+        memcpy(bd.center, center, sizeof bd.center);
+        st = sem_primitive_box(s->model, &bd, &err);
+    }
+    CHECK(st == SEM_OK, "primitive: %s", err.message);
+    if (st != SEM_OK) return 0;
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.rays[0] = po.rays[1] = 4;
+    po.points_per_interval = 4;
+    if (sem_preprocess(s->model, &po, &s->disc, &err) != SEM_OK) {
+        CHECK(0, "preprocess: %s", err.message);
+        return 0;
+    }
+    sem_world_def wd = sem_default_world_def();
+    memcpy(wd.gravity, gravity, sizeof wd.gravity);
+    wd.integrator = integ;
+    wd.dt = 0.01;
+    wd.contact.resolution = 8;
+    s->world = sem_world_create(&wd, &err);
+    CHECK(s->world != NULL, "world: %s", err.message);
+    if (!s->world) return 0;
+    sem_object_def od = sem_default_object_def();
+    od.model = s->model;
+    od.disc = s->disc;
+    od.friction = mu;
+    int id = sem_world_add_object(s->world, &od, &err);
+    CHECK(id == 0, "add object: %s", err.message);
+    return id == 0;
+}
+
+static int add_plane(setup *s, double mu)
+{
+    sem_error err;
+    sem_collider_def cd = sem_default_collider_def();
+    cd.friction = mu;
+    int id = sem_world_add_collider(s->world, &cd, &err);
+    CHECK(id == 0, "collider: %s", err.message);
+    return id == 0;
+}
+
+/* Number 1: the box dropped from 0.5 m (its bottom 0.5 m above the plane). Penetration never
+ * beyond 2 % of its size; after 3 s the kinetic energy is below 0.1 % of the drop's energy
+ * and the centre of mass is at half the box's height (less the sag under its own weight,
+ * rho g h^2 / (4 E) ~ 2.5 mm, plus the spring's rest gap of ~1 mm). */
+static void test_rest(sem_integrator integ, const char *name)
+{
+    setup s;
+    const double center[3] = {0, 0, 1.0}, gravity[3] = {0, 0, -G};
+    if (!make(&s, 0, center, gravity, integ, SEM_DEFAULT_FRICTION) || !add_plane(&s, SEM_DEFAULT_FRICTION)) {
+        setup_free(&s);
+        return;
+    }
+    sem_object_stats st;
+    sem_contact_stats cs;
+    sem_world_object_stats(s.world, 0, &st);
+    double drop_energy = st.mass * G * 0.5, min_gap = INFINITY;
+    int touched = 0;
+    sem_error err;
+    for (int i = 0; i < 300; ++i) {
+        if (sem_world_step(s.world, &err) != SEM_OK) {
+            CHECK(0, "%s step %d: %s", name, i, err.message);
+            break;
+        }
+        sem_world_contact_stats(s.world, &cs);
+        if (cs.min_gap < min_gap) min_gap = cs.min_gap;
+        if (cs.contacts > 0) touched = 1;
+    }
+    sem_world_object_stats(s.world, 0, &st);
+    printf("%s: min gap %.4g m, final KE / drop energy %.3g, com z %.5f, contacts %d\n", name, min_gap,
+           st.kinetic_energy / drop_energy, st.center_of_mass[2], cs.contacts);
+    CHECK(touched, "%s: no contact", name);
+    CHECK(min_gap > -0.02, "%s: penetration %g m (more than 2 %% of 1 m)", name, -min_gap);
+    CHECK(st.kinetic_energy < 1e-3 * drop_energy, "%s: KE %g of %g", name, st.kinetic_energy, drop_energy);
+    CHECK_NEAR(st.center_of_mass[2], 0.5, 0.005);
+    CHECK(cs.contacts > 0, "%s: not resting on the plane", name);
+    setup_free(&s);
+}
+
+/* Without contact the same box falls through the plane: the test above can fail. */
+static void test_disabled(void)
+{
+    setup s;
+    memset(&s, 0, sizeof s);
+    const double center[3] = {0, 0, 1.0}, gravity[3] = {0, 0, -G};
+    if (!make(&s, 0, center, gravity, SEM_IMPLICIT_EULER, 0.5)) {
+        setup_free(&s);
+        return;
+    }
+    sem_world_destroy(s.world);
+    sem_world_def wd = sem_default_world_def();
+    wd.integrator = SEM_IMPLICIT_EULER;
+    wd.contact.disabled = 1;
+    sem_error err;
+    s.world = sem_world_create(&wd, &err);
+    sem_object_def od = sem_default_object_def();
+    od.model = s.model;
+    od.disc = s.disc;
+    CHECK(sem_world_add_object(s.world, &od, &err) == 0, "%s", err.message);
+    add_plane(&s, 0.5);
+    for (int i = 0; i < 60; ++i) sem_world_step(s.world, &err);
+    sem_object_stats st;
+    sem_world_object_stats(s.world, 0, &st);
+    CHECK(st.center_of_mass[2] < 0, "contact disabled: the box should fall through (com z %g)",
+          st.center_of_mass[2]);
+    setup_free(&s);
+}
+
+/* Number 2: the box resting on a 30-degree incline (gravity turned by 30 degrees about y, the
+ * plane z = 0). mu = 0.8 > tan 30: once settled (0.3 s) it moves less than 1 cm in 2 s;
+ * mu = 0.2: it slides with a = g (sin 30 - 0.2 cos 30) = 3.206 m/s^2 (within 5 %). */
+static void test_incline(sem_integrator integ, double mu, const char *name)
+{
+    setup s;
+    const double theta = M_PI / 6;
+    const double center[3] = {0, 0, 0.5 + 1e-3}, gravity[3] = {G * sin(theta), 0, -G * cos(theta)};
+    if (!make(&s, 0, center, gravity, integ, mu) || !add_plane(&s, mu)) {
+        setup_free(&s);
+        return;
+    }
+    sem_error err;
+    sem_object_stats st;
+    double x_settled = 0, v_at[2] = {0, 0};
+    int steps = mu > 0.5 ? 230 : 120;
+    for (int i = 1; i <= steps; ++i) {
+        if (sem_world_step(s.world, &err) != SEM_OK) {
+            CHECK(0, "%s step %d: %s", name, i, err.message);
+            break;
+        }
+        sem_world_object_stats(s.world, 0, &st);
+        if (i == 30) x_settled = st.center_of_mass[0];
+        if (i == 60) v_at[0] = st.linear_momentum[0] / st.mass;
+        if (i == 120) v_at[1] = st.linear_momentum[0] / st.mass;
+    }
+    if (mu > 0.5) {
+        double moved = st.center_of_mass[0] - x_settled;
+        printf("%s: moved %.3g m in 2 s once settled\n", name, moved);
+        CHECK(fabs(moved) < 0.01, "%s: slid %g m", name, moved);
+    } else {
+        double a = (v_at[1] - v_at[0]) / 0.6, expected = G * (sin(theta) - mu * cos(theta));
+        printf("%s: a = %.4f m/s^2 (Coulomb: %.4f)\n", name, a, expected);
+        CHECK_REL(a, expected, 0.05);
+    }
+    setup_free(&s);
+}
+
+/* Number 4: a sphere (r = 0.5) dropped off-centre into a V-shaped valley (two 30-degree
+ * slopes meeting along the x axis, an OBJ-like triangle mesh) settles at the bottom: centre
+ * at y = 0, z = r / cos 30, never passing through the mesh. */
+static void test_valley(void)
+{
+    setup s;
+    const double center[3] = {0, 0.3, 1.2}, gravity[3] = {0, 0, -G};
+    if (!make(&s, 1, center, gravity, SEM_IMPLICIT_EULER, SEM_DEFAULT_FRICTION)) {
+        setup_free(&s);
+        return;
+    }
+    /* 3 x 5 vertices over x in [-2, 2], y in {-2, 0, 2}, z = |y| tan 30 */
+    double v[3 * 15];
+    int t[3 * 16], nt = 0;
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 5; ++i) {
+            double *x = v + 3 * (j * 5 + i);
+            x[0] = -2.0 + i;
+            x[1] = -2.0 + 2.0 * j;
+            x[2] = fabs(x[1]) * tan(M_PI / 6);
+        }
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 4; ++i) {
+            int a = j * 5 + i, b = a + 1, c = a + 5, d = c + 1; /* counter-clockwise from above */
+            t[3 * nt] = a, t[3 * nt + 1] = b, t[3 * nt + 2] = d, ++nt;
+            t[3 * nt] = a, t[3 * nt + 1] = d, t[3 * nt + 2] = c, ++nt;
+        }
+    sem_collider_def cd = sem_default_collider_def();
+    cd.type = SEM_COLLIDER_MESH;
+    cd.vertices = v;
+    cd.n_vertices = 15;
+    cd.triangles = t;
+    cd.n_triangles = nt;
+    sem_error err;
+    CHECK(sem_world_add_collider(s.world, &cd, &err) == 0, "valley: %s", err.message);
+    sem_object_stats st;
+    sem_contact_stats cs;
+    double min_gap = INFINITY;
+    for (int i = 0; i < 250; ++i) {
+        if (sem_world_step(s.world, &err) != SEM_OK) {
+            CHECK(0, "valley step %d: %s", i, err.message);
+            break;
+        }
+        sem_world_contact_stats(s.world, &cs);
+        if (cs.min_gap < min_gap) min_gap = cs.min_gap;
+    }
+    sem_world_object_stats(s.world, 0, &st);
+    double rest_z = 0.5 / cos(M_PI / 6);
+    printf("valley: com (%.4f, %.4f, %.4f) (bottom: 0, 0, %.4f), min gap %.3g, KE %.3g J\n", st.center_of_mass[0],
+           st.center_of_mass[1], st.center_of_mass[2], rest_z, min_gap, st.kinetic_energy);
+    CHECK(min_gap > -0.01, "valley: penetration %g m (2 %% of the radius: 0.01)", -min_gap);
+    CHECK_NEAR(st.center_of_mass[1], 0.0, 0.01);
+    CHECK_NEAR(st.center_of_mass[2], rest_z, 0.01);
+    CHECK(st.kinetic_energy < 1e-3 * st.mass * G * 0.6, "valley: still moving (KE %g J)", st.kinetic_energy);
+    setup_free(&s);
+}
+
+int main(int argc, char **argv)
+{
+    (void)argc;
+    /* as the sem command does (README, "Threads"): sleeping OpenMP threads and a short
+     * OpenBLAS spin, else the two runtimes fight over a small machine's cores */
+    if (!getenv("OMP_WAIT_POLICY") && !getenv("SEM_NO_RESTART")) {
+        setenv("OMP_WAIT_POLICY", "passive", 1);
+        setenv("OPENBLAS_THREAD_TIMEOUT", "20", 1);
+        setenv("SEM_NO_RESTART", "1", 1);
+        execv("/proc/self/exe", argv);
+    }
+    test_rest(SEM_IMPLICIT_EULER, "rest (implicit Euler)");
+    test_rest(SEM_LINEARLY_IMPLICIT_EULER, "rest (linearly implicit Euler)");
+    test_disabled();
+    test_incline(SEM_IMPLICIT_EULER, 0.8, "incline mu 0.8");
+    test_incline(SEM_IMPLICIT_EULER, 0.2, "incline mu 0.2");
+    test_incline(SEM_LINEARLY_IMPLICIT_EULER, 0.2, "incline mu 0.2 (linearly implicit)");
+    test_valley();
+    return test_finish("test_contact");
+}
