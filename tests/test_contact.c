@@ -9,6 +9,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <cjson/cJSON.h>
+
 #include "sem/preprocess.h"
 #include "sem/primitives.h"
 #include "sem/scene.h"
@@ -251,6 +253,118 @@ static void test_valley(void)
     setup_free(&s);
 }
 
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    fputs(text, f);
+    fclose(f);
+}
+
+/* The scene's error for a collider or contact setting: one line naming the key. */
+static void expect_scene_error(const char *dir, const char *json, const char *needle)
+{
+    char path[1024], msg[2048];
+    snprintf(path, sizeof path, "%s/bad.json", dir);
+    write_text(path, json);
+    sem_error err;
+    memset(&err, 0, sizeof err);
+    sem_scene *scene = NULL;
+    sem_scene_world *sw = NULL;
+    sem_status st = sem_scene_load(path, &scene, &err);
+    if (st == SEM_OK) {
+        sem_scene_world_options o = sem_default_scene_world_options();
+        o.skip_modes = 1;
+        st = sem_scene_world_create(scene, &o, &sw, &err);
+    }
+    snprintf(msg, sizeof msg, "%s", err.message);
+    CHECK(st != SEM_OK, "accepted: %s", json);
+    CHECK(strstr(msg, needle) != NULL && !strchr(msg, '\n'), "error \"%s\" lacks \"%s\"", msg, needle);
+    sem_scene_world_destroy(sw);
+    sem_scene_destroy(scene);
+}
+
+#define BOX_OBJECT "\"objects\": [{\"primitive\": {\"type\": \"box\"}, \"sem\": {\"rays\": [4, 4], " \
+                   "\"points_per_interval\": 4}, \"transform\": {\"translate\": [0, 0, 0.6]}}]"
+
+/* Scene keys: colliders (plane, OBJ triangle mesh, primitive), contact settings, object
+ * friction; bad ones are one-line errors naming the key. A short run through the command
+ * line writes the contact numbers into summary.json. */
+static void test_scene(void)
+{
+    const char *dir = test_tmpdir();
+    char path[1024];
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {\"normal\": [0, 0, 0]}}]}",
+                       "colliders[0].plane.normal: must be non-zero");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"missing.obj\"}]}",
+                       "colliders[0].model: ");
+    snprintf(path, sizeof path, "%s/quad.obj", dir);
+    write_text(path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"quad.obj\"}]}",
+                       "colliders[0].model: ");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"quad.obj\"}]}", "quad.obj:5: a face with 4");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {}, \"friction\": -1}]}",
+                       "colliders[0].friction: must be >= 0");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {}, \"model\": \"quad.obj\"}]}",
+                       "colliders[0]: needs exactly one of");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"self\": true}}", "contact.self");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"stiffness\": -3}}", "contact.stiffness: must be positive");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"stifness\": 3}}", "contact: unknown key \"stifness\"");
+    expect_scene_error(dir,
+                       "{\"objects\": [{\"primitive\": {\"type\": \"box\"}, \"friction\": -0.1}]}",
+                       "objects[0].friction: must be >= 0");
+
+    /* a box resting on a triangle-mesh floor (OBJ) and a plane wall, through `sem run` */
+    snprintf(path, sizeof path, "%s/floor.obj", dir);
+    write_text(path, "# a 4 x 4 m floor at z = 0\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nf 1 2 3\nf 1/1 3/3 4/4\n");
+    snprintf(path, sizeof path, "%s/floor.json", dir);
+    write_text(path, "{\"objects\": [{\"primitive\": {\"type\": \"box\"}, \"sem\": {\"rays\": [4, 4], "
+                     "\"points_per_interval\": 4}, \"transform\": {\"translate\": [0, 0, 0.5005]}, \"friction\": 0.6}],\n"
+                     " \"colliders\": [{\"model\": \"floor.obj\", \"friction\": 0.6},\n"
+                     "               {\"plane\": {\"point\": [5, 0, 0], \"normal\": [-1, 0, 0]}}],\n"
+                     " \"contact\": {\"resolution\": 4},\n"
+                     " \"integrator\": {\"type\": \"implicit_euler\", \"dt\": 0.01}, \"frames\": 3,\n"
+                     " \"output\": {\"iges\": false, \"mesh\": false, \"usd\": false, \"glb\": false}}\n");
+    char args[2048], out[1 << 16], errbuf[4096];
+    snprintf(args, sizeof args, "run %s --out %s/floor_out --quiet --no-cache", path, dir);
+    int rc = test_run_cli(args, out, sizeof out, errbuf, sizeof errbuf);
+    CHECK(rc == 0, "sem run floor.json: %d %s", rc, errbuf);
+    snprintf(path, sizeof path, "%s/floor_out/summary.json", dir);
+    FILE *f = fopen(path, "rb");
+    char *text = NULL;
+    if (f) {
+        fseek(f, 0, SEEK_END);
+        long n = ftell(f);
+        fseek(f, 0, SEEK_SET);
+        text = calloc((size_t)n + 1, 1);
+        if (text && fread(text, 1, (size_t)n, f) != (size_t)n) text[0] = 0;
+        fclose(f);
+    }
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    CHECK(j != NULL, "summary.json unreadable");
+    if (j) {
+        const cJSON *frames = cJSON_GetObjectItem(j, "frames");
+        const cJSON *last = cJSON_GetArrayItem(frames, cJSON_GetArraySize(frames) - 1);
+        const cJSON *contacts = cJSON_GetObjectItem(last, "contacts"), *gap = cJSON_GetObjectItem(last, "min_gap");
+        const cJSON *objs = cJSON_GetObjectItem(last, "objects");
+        const cJSON *o0 = cJSON_GetArrayItem(objs, 0);
+        CHECK(cJSON_IsNumber(contacts) && contacts->valuedouble > 0, "summary: contacts");
+        CHECK(cJSON_IsNumber(gap) && fabs(gap->valuedouble) < 0.01, "summary: min_gap %g",
+              cJSON_IsNumber(gap) ? gap->valuedouble : -1.0);
+        CHECK(cJSON_GetArraySize(objs) == 1 && cJSON_GetObjectItem(o0, "center_of_mass") &&
+                  cJSON_GetObjectItem(o0, "linear_momentum") && cJSON_GetObjectItem(o0, "angular_momentum") &&
+                  cJSON_IsNumber(cJSON_GetObjectItem(o0, "kinetic_energy")),
+              "summary: per-object numbers");
+        const cJSON *com = cJSON_GetObjectItem(o0, "center_of_mass");
+        CHECK(fabs(cJSON_GetArrayItem(com, 2)->valuedouble - 0.5) < 0.01, "box resting on the OBJ floor: com z %g",
+              cJSON_GetArrayItem(com, 2)->valuedouble);
+        CHECK(cJSON_IsNumber(cJSON_GetObjectItem(j, "contact_s")), "summary: contact_s");
+        cJSON_Delete(j);
+    }
+    free(text);
+}
+
 int main(int argc, char **argv)
 {
     (void)argc;
@@ -262,6 +376,7 @@ int main(int argc, char **argv)
         setenv("SEM_NO_RESTART", "1", 1);
         execv("/proc/self/exe", argv);
     }
+    test_scene();
     test_rest(SEM_IMPLICIT_EULER, "rest (implicit Euler)");
     test_rest(SEM_LINEARLY_IMPLICIT_EULER, "rest (linearly implicit Euler)");
     test_disabled();
