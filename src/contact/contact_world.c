@@ -74,6 +74,9 @@ struct sem_contact {
     int n_fweights, cap_fweights;
     sem_point_weight *fweights;
     double friction_eps;     /* eps_v h of the step; 0: no friction */
+    int n_couplings, cap_couplings;
+    sem_system_coupling *couplings; /* the blocks contact between objects needs */
+    long rebuilds;           /* systems made again for new coupling blocks */
     sem_contact_stats stats;
 };
 
@@ -120,6 +123,7 @@ void sem_contact_destroy(sem_contact *c)
     free(c->sys_to_contact);
     free(c->friction);
     free(c->fweights);
+    free(c->couplings);
     sem_point_terms_free(&c->terms);
     sem_point_terms_free(&c->friction_terms);
     free(c);
@@ -535,6 +539,42 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
     return SEM_OK;
 }
 
+/* Friction for the linearly implicit step, as a damper: each contact's tangential motion
+ * u = h T^T J v+ over the step meets the force -c u, c = mu lambda f1(y) / y at the slip
+ * y = |u| predicted from v_n (friction.h). Sliding steadily, |u| = y and the force is
+ * exactly mu lambda (Coulomb); sticking, c = 2 mu lambda / eps holds the contact. Linear in
+ * v+ and dissipative, so the step stays stable; the tangent linearization about v_n (the
+ * Newton Hessian) instead extrapolates a saturating force and throws objects apart when
+ * their relative velocity changes within a step (an impact). Only the matrix changes:
+ * h^2 c J^T T T^T J. */
+static sem_status friction_damper(sem_contact *c, const sem_system *s, const double *qpred, sem_point_terms *terms,
+                                  sem_error *err)
+{
+    if (!(c->friction_eps > 0)) return SEM_OK;
+    for (int i = 0; i < c->n_friction; ++i) {
+        const friction_rec *fr = &c->friction[i];
+        const sem_point_weight *w = c->fweights + fr->first;
+        double X[3], u[2], g[2];
+        relative_point(s, w, fr->count, qpred, X);
+        for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
+        u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
+        u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
+        double y = sqrt(u[0] * u[0] + u[1] * u[1]), damping;
+        if (y > 0) {
+            sem_friction_potential(fr->mu_lambda, u, c->friction_eps, g, NULL);
+            damping = sqrt(g[0] * g[0] + g[1] * g[1]) / y;
+        } else
+            damping = 2 * fr->mu_lambda / c->friction_eps;
+        double H[9];
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                H[3 * a + b] = damping * (fr->T[2 * a] * fr->T[2 * b] + fr->T[2 * a + 1] * fr->T[2 * b + 1]);
+        sem_status st = sem_point_terms_push(terms, w, fr->count, H, err);
+        if (st != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
 /* The system's objects' a q + b v as one vector (the caller frees). */
 static double *system_q(const sem_system *s, double a, double b)
 {
@@ -551,8 +591,41 @@ static double *system_q(const sem_system *s, double a, double b)
 /* ---------------------------------------------------------------------------------- */
 /* the step                                                                            */
 
-sem_status sem_contact_begin_step(sem_contact *c, const sem_system *s, double h, sem_error *err)
+/* The coupling blocks contact between objects needs at q (contacts within the search
+ * radius: a superset of those a step's iterates can activate), in c->couplings. */
+static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_error *err)
 {
+    c->n_couplings = 0;
+    for (int i = 0; i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        if (r->other < 0) continue;
+        const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
+        const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
+        int ga = s->objects[r->k]->ctrl_group[m->row_ctrl[m->row_start[r->point]]];
+        int p = mo->triangles[3 * r->triangle];
+        int gb = s->objects[r->other]->ctrl_group[mo->row_ctrl[mo->row_start[p]]];
+        sem_system_coupling cp = r->k < r->other ? (sem_system_coupling){r->k, ga, r->other, gb}
+                                                 : (sem_system_coupling){r->other, gb, r->k, ga};
+        int seen = 0;
+        for (int j = 0; j < c->n_couplings && !seen; ++j)
+            seen = !memcmp(&c->couplings[j], &cp, sizeof cp);
+        if (seen) continue;
+        if (c->n_couplings == c->cap_couplings) {
+            int cap = c->cap_couplings ? 2 * c->cap_couplings : 64;
+            sem_system_coupling *x = realloc(c->couplings, (size_t)cap * sizeof *x);
+            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            c->couplings = x;
+            c->cap_couplings = cap;
+        }
+        c->couplings[c->n_couplings++] = cp;
+    }
+    return SEM_OK;
+}
+
+sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h, sem_solver_choice solver,
+                                  sem_error *err)
+{
+    const sem_system *s = *system;
     c->stats.seconds = 0;
     c->n_friction = 0;
     c->n_fweights = 0;
@@ -561,7 +634,27 @@ sem_status sem_contact_begin_step(sem_contact *c, const sem_system *s, double h,
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    sem_status st = detect(c, s, q, 0, err);
+    sem_status st = detect(c, s, q, s->n_objects > 1 ? 1 : 0, err);
+    /* objects near each other: their coupling blocks in the system's pattern (a new system
+     * when some are missing; point_terms.h) */
+    if (st == SEM_OK && s->n_objects > 1) st = needed_couplings(c, s, err);
+    if (st == SEM_OK && s->n_objects > 1) {
+        int missing = 0;
+        for (int i = 0; i < c->n_couplings && !missing; ++i)
+            missing = sem_system_find_coupling(s, c->couplings[i].a, c->couplings[i].ga, c->couplings[i].b,
+                                               c->couplings[i].gb) < 0;
+        if (missing) {
+            sem_system *ns = NULL;
+            st = sem_system_create_coupled(s->objects, s->n_objects, c->couplings, c->n_couplings, solver, &ns, err);
+            if (st == SEM_OK) {
+                sem_system_destroy(*system);
+                *system = ns;
+                s = ns;
+                c->rebuilds++;
+            } else /* the objects point to the system they had */
+                for (int k = 0; k < s->n_objects; ++k) s->objects[k]->system = *system;
+        }
+    }
     c->friction_eps = h > 0 ? c->def.friction_velocity * h : 0;
     sem_point_weight w[MAX_WEIGHTS];
     for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < c->n_recs; ++i) {
@@ -634,13 +727,15 @@ sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, doubl
     sem_point_terms_clear(&c->terms);
     if ((st = detect(c, s, q, 1, err)) != SEM_OK) goto done;
     if ((st = springs(c, s, g, &c->terms, &E, v, h, err)) != SEM_OK) goto done;
-    sem_system_add_point_terms(s, &c->terms, h * h);
-    /* friction linearized about v_n: its force at q_n + h v_n, and h^2 H (v+ - v_n) */
+    /* friction as a damper lagged from the predicted slip (friction_damper) */
     sem_point_terms_clear(&c->friction_terms);
-    if ((st = friction(c, s, qpred, g, &c->friction_terms, &E, err)) != SEM_OK) goto done;
-    sem_system_add_point_terms(s, &c->friction_terms, h * h);
+    if ((st = friction_damper(c, s, qpred, &c->friction_terms, err)) != SEM_OK) goto done;
+    {
+        const sem_point_terms *lists[2] = {&c->terms, &c->friction_terms};
+        const double scale[2] = {h * h, h * h};
+        sem_system_set_point_terms(s, lists, scale, 2);
+    }
     for (size_t i = 0; i < s->n_dofs; ++i) rhs[i] -= h * g[i];
-    sem_point_terms_multiply(s, &c->friction_terms, h * h, v, rhs);
 done:
     free(q);
     free(qpred);

@@ -5,7 +5,9 @@
  *
  * How a step uses it (docs/simulation.md, "Contact"):
  *   sem_contact_begin_step    at q_n: finds the active contacts and fixes friction's normal
- *                             forces, tangent planes and reference points (IPC's lagging)
+ *                             forces, tangent planes and reference points (IPC's lagging);
+ *                             objects near each other get their coupling blocks in the
+ *                             system's pattern (a new system when blocks are missing)
  *   sem_contact_potential     Newton (implicit Euler, statics): the energy of the springs
  *                             and of friction at any q of the system, its gradient, and its
  *                             Hessian as point terms (src/physics/point_terms.h) that Newton
@@ -47,7 +49,10 @@ int sem_contact_between_objects(const sem_contact *c);
 /* 1 when anything can touch (colliders, or contact between objects). */
 int sem_contact_active(const sem_contact *c);
 
-sem_status sem_contact_begin_step(sem_contact *c, const sem_system *s, double h, sem_error *err);
+/* Also makes the system again (solver: its choice) when objects came near each other and
+ * its pattern lacks the coupling blocks their contact needs: *s may change. */
+sem_status sem_contact_begin_step(sem_contact *c, sem_system **s, double h, sem_solver_choice solver,
+                                  sem_error *err);
 /* The contact energy at the system's vector q (springs; friction when h > 0); its gradient
  * is added to grad (n_dofs, may be NULL) and, with grad, its Hessian becomes the terms
  * sem_contact_terms returns. */

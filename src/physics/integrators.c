@@ -98,10 +98,12 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
     w->last_iterations = 0;
     double h = w->def.dt, t1 = w->time + h;
     for (int i = 0; i < w->n_systems; ++i) {
-        sem_system *s = w->systems[i];
-        /* contact: friction lagged at q_n (contact_world.h) */
-        sem_status st = sem_contact_begin_step(w->contact, s, w->def.integrator == SEM_STATIC ? 0.0 : h, err);
+        /* contact: friction lagged at q_n, coupling blocks between objects near each other
+         * (contact_world.h; may make the system again) */
+        sem_status st = sem_contact_begin_step(w->contact, &w->systems[i],
+                                               w->def.integrator == SEM_STATIC ? 0.0 : h, w->def.solver, err);
         if (st != SEM_OK) return st;
+        sem_system *s = w->systems[i];
         switch (w->def.integrator) {
         case SEM_LINEARLY_IMPLICIT_EULER: st = step_linearly_implicit(w, s, err); break;
         case SEM_IMPLICIT_EULER: st = sem_newton_solve(w, s, h, t1, w->def.newton_max_iterations, err); break;
@@ -126,7 +128,7 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
 {
     int max_iterations = w->def.newton_max_iterations < 200 ? 200 : w->def.newton_max_iterations;
     for (int i = 0; i < w->n_systems; ++i) {
-        sem_status st = sem_contact_begin_step(w->contact, w->systems[i], 0.0, err);
+        sem_status st = sem_contact_begin_step(w->contact, &w->systems[i], 0.0, w->def.solver, err);
         if (st == SEM_OK) st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);
         if (st != SEM_OK) return st;
         sem_contact_end_step(w->contact, w->systems[i]);

@@ -103,7 +103,10 @@ static void set_exact_hessian(sem_system *s, int on)
 static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, sem_error *err)
 {
     sem_system_fill(s, cM, 1.0, 1.0, cD);
-    sem_system_add_point_terms(s, sem_contact_terms(w->contact), 1.0); /* contact */
+    /* contact: its Hessian (point_terms.h) */
+    const sem_point_terms *contact = sem_contact_terms(w->contact);
+    const double one = 1.0;
+    sem_system_set_point_terms(s, &contact, &one, 1);
     sem_status st = sem_system_factorize(s, err);
     w->last_factor_s += sem_system_factor_seconds(s);
     w->counters.factorizations++;
