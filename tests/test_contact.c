@@ -374,10 +374,10 @@ static void test_scene(void)
     expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"missing.obj\"}]}",
                        "colliders[0].model: ");
     snprintf(path, sizeof path, "%s/quad.obj", dir);
-    write_text(path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    write_text(path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0.5 0\nf 1 2 3\nf 1 2 3 4\nf 1 2 3 4 5\n");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"quad.obj\"}]}",
                        "colliders[0].model: ");
-    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"quad.obj\"}]}", "quad.obj:5: a face with 4");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"model\": \"quad.obj\"}]}", "quad.obj:8: a face with 5");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {}, \"friction\": -1}]}",
                        "colliders[0].friction: must be >= 0");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {}, \"model\": \"quad.obj\"}]}",

@@ -26,12 +26,13 @@ extern "C" {
 /* Contact settings of a world (zero: the defaults). */
 typedef struct sem_contact_def {
     /* Penalty stiffness per unit area (N/m^3: the contact pressure per metre of
-     * penetration); <= 0: 100 E / L with E the smaller Young's modulus of the two sides and
-     * L the object's size (bounding-box diagonal): a body resting on its face sinks by
-     * about 1 % of the strain its own weight causes. */
+     * penetration); <= 0: 1000 E / L with E the smaller Young's modulus of the two sides and
+     * L the object's size (bounding-box diagonal): a body resting on a face sinks into it by
+     * about 1e-3 of the strain its own weight causes (the springs are much stiffer than the
+     * body they stop). */
     double stiffness;
-    /* Distance at which the springs start (m); < 0: 1e-3 L of each object; 0: none (the
-     * springs act from touching on). */
+    /* Distance from a surface at which the springs start (m); <= 0: 1e-3 L of each object.
+     * A resting object floats about this far above what it rests on. */
     double thickness;
     int self;              /* 1: an object's parts push each other too (not implemented) */
     int disabled;          /* 1: no contact at all (objects pass through each other) */

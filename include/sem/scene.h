@@ -116,7 +116,7 @@ sem_status sem_scene_object_model(const sem_scene *scene, int object, sem_model 
 /* The collider's definition for sem_world_add_collider: a plane, or the triangles of its
  * model (tessellated) or OBJ triangle mesh, in metres and transformed. *vertices and
  * *triangles (NULL for a plane) are the caller's to free. Errors name the key
- * ("scene.json: colliders[0].model: terrain.obj:12: a face with 4 vertices ..."). */
+ * ("scene.json: colliders[0].model: terrain.obj:12: a face with 5 vertices ..."). */
 sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collider_def *out,
                                   double **vertices, int **triangles, sem_error *err);
 /* Metres per unit of a unit name ("mm", "M", "inch", ...; case-insensitive), 0 if unknown.

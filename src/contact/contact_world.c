@@ -16,7 +16,7 @@
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
 #define KAPPA 1000.0
 #define DEFAULT_THICKNESS 1e-3     /* x L */
-#define SEARCH_DEPTH 0.25          /* x L: how deep a point may be and still be pushed out */
+#define SEARCH_DEPTH 0.05          /* x L: how deep a point may be and still be pushed out */
 #define DEFAULT_FRICTION_VELOCITY 1e-3
 #define MAX_WEIGHTS 192            /* a point's row plus a triangle's three rows */
 
@@ -35,6 +35,7 @@ typedef struct collider {
 
 typedef struct contact_object {
     const sem_object *object;
+    int built;               /* mesh and the numbers below (mesh_for) */
     sem_collision_mesh mesh;
     double youngs, friction, length, thickness;
 } contact_object;
@@ -63,6 +64,10 @@ struct sem_contact {
     /* per evaluation */
     int n_recs, cap_recs;
     contact_rec *recs;
+    contact_rec *slots;      /* detection scratch: per point of an object, its contacts */
+    int *slot_count;
+    size_t cap_slots;
+    int cap_count;
     int *sys_to_contact;     /* system object -> contact object */
     int n_sys;
     double min_gap;
@@ -120,6 +125,8 @@ void sem_contact_destroy(sem_contact *c)
     free(c->colliders);
     free(c->objects);
     free(c->recs);
+    free(c->slots);
+    free(c->slot_count);
     free(c->sys_to_contact);
     free(c->friction);
     free(c->fweights);
@@ -283,18 +290,24 @@ sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error
     contact_object *co = &c->objects[c->n_objects];
     memset(co, 0, sizeof *co);
     co->object = o;
-    if (c->def.disabled) {
-        /* no contact at all: no mesh (a mesh of zero points) */
-        c->n_objects++;
-        return SEM_OK;
-    }
+    c->n_objects++;
+    return SEM_OK; /* its mesh is built when contact first needs it (mesh_for) */
+}
+
+/* The collision mesh of contact object i, built on first use: a world with one object and
+ * no collider never pays for it. */
+static sem_status mesh_for(sem_contact *c, int i, sem_error *err)
+{
+    contact_object *co = &c->objects[i];
+    if (co->built) return SEM_OK;
+    const sem_object *o = co->object;
     sem_status st = sem_collision_mesh_build(o->def.model, c->def.resolution, &co->mesh, err);
     if (st != SEM_OK) return st;
     co->youngs = o->def.material.youngs_modulus;
     co->friction = o->def.friction;
     co->length = co->mesh.length > 0 ? co->mesh.length : 1.0;
     co->thickness = c->def.thickness > 0 ? c->def.thickness : DEFAULT_THICKNESS * co->length;
-    c->n_objects++;
+    co->built = 1;
     return SEM_OK;
 }
 
@@ -332,6 +345,8 @@ static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err
             if (c->objects[i].object == s->objects[k]) c->sys_to_contact[k] = i;
         if (c->sys_to_contact[k] < 0)
             return sem_error_set(err, SEM_ERR_INVALID, "contact: an object of the system is not in the world");
+        sem_status st = mesh_for(c, c->sys_to_contact[k], err);
+        if (st != SEM_OK) return st;
     }
     return SEM_OK;
 }
@@ -349,8 +364,79 @@ static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
     return SEM_OK;
 }
 
-/* Every contact at the system's vector q closer than thickness + margin x (the search
- * radius) into c->recs (margin 0: the active ones), and c->min_gap. */
+/* The contacts of point p of system object k (thickness + margin x the search radius,
+ * margin 0: the active ones) into out (at most n_colliders + n_objects - 1); returns their
+ * count and lowers *min_gap. */
+static int point_contacts(const sem_contact *c, const sem_system *s, int k, int p, double margin, contact_rec *out,
+                          double *min_gap)
+{
+    const contact_object *co = &c->objects[c->sys_to_contact[k]];
+    const sem_collision_mesh *m = &co->mesh;
+    double th = co->thickness, L = co->length;
+    double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
+    double radius = th + SEARCH_DEPTH * L;
+    const double *x = m->x + 3 * (size_t)p;
+    int n = 0;
+    for (int i = 0; i < c->n_colliders; ++i) {
+        const collider *col = &c->colliders[i];
+        contact_rec r = {k, p, -1, i, -1, {0, 0, 0}, 0, {0, 0, 0}, 0, th, 0};
+        if (col->type == SEM_COLLIDER_PLANE) {
+            double diff[3] = {x[0] - col->point[0], x[1] - col->point[1], x[2] - col->point[2]};
+            r.d = dot3(diff, col->normal);
+            memcpy(r.n, col->normal, sizeof r.n);
+        } else {
+            sem_tri_closest cl;
+            int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, radius * radius, &cl);
+            if (t < 0) continue;
+            const double *outward = cl.feature == SEM_TRI_FACE   ? col->face_normal + 3 * (size_t)t
+                                    : cl.feature == SEM_TRI_EDGE ? col->edge_normal + 9 * (size_t)t + 3 * cl.index
+                                                                 : col->vertex_normal +
+                                                                       3 * (size_t)col->triangles[3 * t + cl.index];
+            r.d = sem_signed_distance(x, cl.point, outward, r.n);
+        }
+        if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
+        if (!(r.d < th + margin * radius)) continue;
+        r.stiffness = own_stiffness * m->area[p];
+        r.mu = sqrt(co->friction * col->friction);
+        out[n++] = r;
+    }
+    if (s->n_objects < 2) return n;
+    for (int j = 0; j < s->n_objects; ++j) {
+        if (j == k) continue;
+        const contact_object *cj = &c->objects[c->sys_to_contact[j]];
+        const sem_collision_mesh *mj = &cj->mesh;
+        sem_tri_closest cl;
+        int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, radius * radius, &cl);
+        if (t < 0) continue;
+        contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
+        const int *tri = mj->triangles + 3 * t;
+        double outward[3] = {0, 0, 0};
+        if (cl.feature == SEM_TRI_FACE) {
+            const double *a = mj->x + 3 * (size_t)tri[0], *b = mj->x + 3 * (size_t)tri[1], *cc = mj->x + 3 * (size_t)tri[2];
+            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+            outward[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            outward[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            outward[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        } else
+            for (int v = 0; v < 3; ++v)
+                if (cl.bary[v] > 0)
+                    for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
+        r.d = sem_signed_distance(x, cl.point, outward, r.n);
+        if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
+        if (!(r.d < th + margin * radius)) continue;
+        double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
+        r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
+        r.mu = sqrt(co->friction * cj->friction);
+        out[n++] = r;
+    }
+    return n;
+}
+
+/* Every contact at the system's vector q closer than thickness + margin x the search
+ * radius (margin 0: the active ones) into c->recs, and c->min_gap. Points are tested in
+ * parallel, each into slots of its own, and the slots are gathered in point order: the
+ * list is the same on any thread count. */
 static sem_status detect(sem_contact *c, const sem_system *s, const double *q, double margin, sem_error *err)
 {
     sem_status st = map_system(c, s, err);
@@ -361,70 +447,36 @@ static sem_status detect(sem_contact *c, const sem_system *s, const double *q, d
     int between = s->n_objects >= 2;
     for (int k = 0; k < s->n_objects; ++k)
         sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
+    int per_point = c->n_colliders + s->n_objects - 1;
+    if (per_point <= 0) return SEM_OK;
+    int nthreads = s->n_objects > 0 ? s->objects[0]->nthreads : 1;
     for (int k = 0; k < s->n_objects; ++k) {
-        const contact_object *co = &c->objects[c->sys_to_contact[k]];
-        const sem_collision_mesh *m = &co->mesh;
-        double th = co->thickness, L = co->length;
-        double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
-        double radius = th + SEARCH_DEPTH * L;
-        for (int p = 0; p < m->n_points; ++p) {
-            if (!(m->area[p] > 0)) continue;
-            const double *x = m->x + 3 * (size_t)p;
-            for (int i = 0; i < c->n_colliders; ++i) {
-                const collider *col = &c->colliders[i];
-                contact_rec r = {k, p, -1, i, -1, {0, 0, 0}, 0, {0, 0, 0}, 0, th, 0};
-                if (col->type == SEM_COLLIDER_PLANE) {
-                    double diff[3] = {x[0] - col->point[0], x[1] - col->point[1], x[2] - col->point[2]};
-                    r.d = dot3(diff, col->normal);
-                    memcpy(r.n, col->normal, sizeof r.n);
-                } else {
-                    sem_tri_closest cl;
-                    int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, radius * radius, &cl);
-                    if (t < 0) continue;
-                    const double *outward = cl.feature == SEM_TRI_FACE   ? col->face_normal + 3 * (size_t)t
-                                            : cl.feature == SEM_TRI_EDGE ? col->edge_normal + 9 * (size_t)t + 3 * cl.index
-                                                                         : col->vertex_normal +
-                                                                               3 * (size_t)col->triangles[3 * t + cl.index];
-                    r.d = sem_signed_distance(x, cl.point, outward, r.n);
-                }
-                if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
-                if (!(r.d < th + margin * radius)) continue;
-                r.stiffness = own_stiffness * m->area[p];
-                r.mu = sqrt(co->friction * col->friction);
-                if ((st = push_rec(c, &r, err)) != SEM_OK) return st;
-            }
-            if (!between) continue;
-            for (int j = 0; j < s->n_objects; ++j) {
-                if (j == k) continue;
-                const contact_object *cj = &c->objects[c->sys_to_contact[j]];
-                const sem_collision_mesh *mj = &cj->mesh;
-                sem_tri_closest cl;
-                int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, radius * radius, &cl);
-                if (t < 0) continue;
-                contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
-                const int *tri = mj->triangles + 3 * t;
-                double outward[3] = {0, 0, 0};
-                if (cl.feature == SEM_TRI_FACE) {
-                    const double *a = mj->x + 3 * (size_t)tri[0], *b = mj->x + 3 * (size_t)tri[1],
-                                 *cc = mj->x + 3 * (size_t)tri[2];
-                    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-                    double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
-                    outward[0] = e1[1] * e2[2] - e1[2] * e2[1];
-                    outward[1] = e1[2] * e2[0] - e1[0] * e2[2];
-                    outward[2] = e1[0] * e2[1] - e1[1] * e2[0];
-                } else
-                    for (int v = 0; v < 3; ++v)
-                        if (cl.bary[v] > 0)
-                            for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
-                r.d = sem_signed_distance(x, cl.point, outward, r.n);
-                if (r.d < c->min_gap && r.d < radius) c->min_gap = r.d;
-                if (!(r.d < th + margin * radius)) continue;
-                double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
-                r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
-                r.mu = sqrt(co->friction * cj->friction);
-                if ((st = push_rec(c, &r, err)) != SEM_OK) return st;
-            }
+        const sem_collision_mesh *m = &c->objects[c->sys_to_contact[k]].mesh;
+        size_t need = (size_t)m->n_points * (size_t)per_point;
+        if (need > c->cap_slots) {
+            contact_rec *x = realloc(c->slots, need * sizeof *x);
+            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+            c->slots = x;
+            c->cap_slots = need;
         }
+        if (m->n_points > c->cap_count) {
+            int *y = realloc(c->slot_count, (size_t)m->n_points * sizeof *y);
+            if (!y) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+            c->slot_count = y;
+            c->cap_count = m->n_points;
+        }
+        double gap = INFINITY;
+#pragma omp parallel for schedule(static) reduction(min : gap) num_threads(nthreads)
+        for (int p = 0; p < m->n_points; ++p) {
+            c->slot_count[p] = 0;
+            if (m->area[p] > 0)
+                c->slot_count[p] =
+                    point_contacts(c, s, k, p, margin, c->slots + (size_t)p * (size_t)per_point, &gap);
+        }
+        if (gap < c->min_gap) c->min_gap = gap;
+        for (int p = 0; p < m->n_points; ++p)
+            for (int i = 0; i < c->slot_count[p]; ++i)
+                if ((st = push_rec(c, &c->slots[(size_t)p * (size_t)per_point + (size_t)i], err)) != SEM_OK) return st;
     }
     return SEM_OK;
 }

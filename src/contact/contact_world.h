@@ -19,8 +19,8 @@
  * Detection. Every collision point (collision_mesh.h) is tested against every collider
  * (planes: the signed distance; triangle meshes: the nearest triangle within a search
  * radius through the mesh's tree, signed by its pseudonormals) and against the other
- * objects' triangle meshes (refitted trees), within the radius thickness + L / 4 (L the
- * point's object's size): a point that went deeper than L / 4 into a mesh in one step is
+ * objects' triangle meshes (refitted trees), within the radius thickness + L / 20 (L the
+ * point's object's size): a point that went deeper than L / 20 into a mesh in one step is
  * lost (tunnels). Planes are half-spaces and have no such limit.
  *
  * Contact between objects needs both in one linear system: while it is on (two objects or

@@ -76,7 +76,7 @@ sem_status sem_obj_triangles_read(const char *path, sem_triangle_soup *out, int 
             memcpy(out->vertices + 3 * (size_t)out->n_vertices, x, sizeof x);
             out->n_vertices++;
         } else if (keyword(s, "f")) {
-            int idx[4], n = 0;
+            int idx[5], n = 0;
             char *p = s + 1;
             for (;;) {
                 while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
@@ -95,18 +95,39 @@ sem_status sem_obj_triangles_read(const char *path, sem_triangle_soup *out, int 
                                        path, line, v, out->n_vertices);
                     goto done;
                 }
-                if (n < 4) idx[n] = (int)i;
+                if (n < 5) idx[n] = (int)i;
                 ++n;
             }
-            if (n != 3) {
+            if (n != 3 && n != 4) {
                 st = sem_error_set(err, SEM_ERR_PARSE,
-                                   "%s:%d: a face with %d vertices (collider meshes take triangles only)", path,
-                                   line, n);
+                                   "%s:%d: a face with %d vertices (collider meshes take triangles and quads)",
+                                   path, line, n);
                 goto done;
             }
-            if (!grow((void **)&out->triangles, &cap_t, 3 * (out->n_triangles + 1), sizeof(int))) goto nomem;
-            memcpy(out->triangles + 3 * (size_t)out->n_triangles, idx, 3 * sizeof(int));
-            out->n_triangles++;
+            /* a quad is two triangles, split along its shorter diagonal (terrains exported
+             * from modelling tools mix both) */
+            int tri[6] = {idx[0], idx[1], idx[2], 0, 0, 0}, nt = 1;
+            if (n == 4) {
+                const double *v = out->vertices;
+                double d02 = 0, d13 = 0;
+                for (int k = 0; k < 3; ++k) {
+                    double a = v[3 * (size_t)idx[0] + k] - v[3 * (size_t)idx[2] + k];
+                    double b = v[3 * (size_t)idx[1] + k] - v[3 * (size_t)idx[3] + k];
+                    d02 += a * a;
+                    d13 += b * b;
+                }
+                if (d02 <= d13) {
+                    int t[6] = {idx[0], idx[1], idx[2], idx[0], idx[2], idx[3]};
+                    memcpy(tri, t, sizeof t);
+                } else {
+                    int t[6] = {idx[0], idx[1], idx[3], idx[1], idx[2], idx[3]};
+                    memcpy(tri, t, sizeof t);
+                }
+                nt = 2;
+            }
+            if (!grow((void **)&out->triangles, &cap_t, 3 * (out->n_triangles + nt), sizeof(int))) goto nomem;
+            memcpy(out->triangles + 3 * (size_t)out->n_triangles, tri, 3 * (size_t)nt * sizeof(int));
+            out->n_triangles += nt;
         }
         if (!eol) break;
         s = eol + 1;

@@ -15,8 +15,9 @@ typedef struct sem_triangle_soup {
 
 /* Reads the 'v' and 'f' statements of an OBJ file (regular files up to
  * SEM_MAX_MODEL_FILE_BYTES; 'v/vt/vn' references and negative indices allowed; other
- * statements skipped). A face with other than 3 vertices, an index out of range or a file
- * with no face is an error "FILE:LINE: ...". *freeform (may be NULL) is set to 1 instead,
+ * statements skipped). Quads become two triangles (split along the shorter diagonal); a
+ * face with fewer than 3 or more than 4 vertices, an index out of range or a file with no
+ * face is an error "FILE:LINE: ...". *freeform (may be NULL) is set to 1 instead,
  * with nothing read, when the file holds free-form surfaces ("surf"): read it as a model. */
 sem_status sem_obj_triangles_read(const char *path, sem_triangle_soup *out, int *freeform, sem_error *err);
 void sem_triangle_soup_free(sem_triangle_soup *s);
