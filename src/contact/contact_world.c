@@ -375,6 +375,8 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
     double th = co->thickness, L = co->length;
     double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
     double radius = th + SEARCH_DEPTH * L;
+    /* how far to look: the search radius, or the contacts within th + margin x radius */
+    double reach = margin > 1 ? th + margin * radius : radius, reach2 = reach * reach;
     const double *x = m->x + 3 * (size_t)p;
     int n = 0;
     for (int i = 0; i < c->n_colliders; ++i) {
@@ -386,7 +388,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
             memcpy(r.n, col->normal, sizeof r.n);
         } else {
             sem_tri_closest cl;
-            int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, radius * radius, &cl);
+            int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, reach2, &cl);
             if (t < 0) continue;
             const double *outward = cl.feature == SEM_TRI_FACE   ? col->face_normal + 3 * (size_t)t
                                     : cl.feature == SEM_TRI_EDGE ? col->edge_normal + 9 * (size_t)t + 3 * cl.index
@@ -406,7 +408,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         const contact_object *cj = &c->objects[c->sys_to_contact[j]];
         const sem_collision_mesh *mj = &cj->mesh;
         sem_tri_closest cl;
-        int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, radius * radius, &cl);
+        int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, reach2, &cl);
         if (t < 0) continue;
         contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
         const int *tri = mj->triangles + 3 * t;
@@ -696,6 +698,12 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
             missing = sem_system_find_coupling(s, c->couplings[i].a, c->couplings[i].ga, c->couplings[i].b,
                                                c->couplings[i].gb) < 0;
         if (missing) {
+            /* ask for the blocks of parts up to three search radii apart, so that objects
+             * approaching each other do not need a new system every step */
+            if ((st = detect(c, s, q, 3, err)) == SEM_OK) st = needed_couplings(c, s, err);
+            if (st == SEM_OK) st = detect(c, s, q, 1, err); /* the step's contacts again */
+        }
+        if (missing && st == SEM_OK) {
             sem_system *ns = NULL;
             st = sem_system_create_coupled(s->objects, s->n_objects, c->couplings, c->n_couplings, solver, &ns, err);
             if (st == SEM_OK) {
