@@ -11,6 +11,8 @@
 
 #include <cjson/cJSON.h>
 
+#include "contact/friction.h"
+#include "contact/narrow_phase.h"
 #include "sem/preprocess.h"
 #include "sem/primitives.h"
 #include "sem/scene.h"
@@ -328,6 +330,45 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     setup_free(&b);
 }
 
+/* The pieces against closed forms and finite differences: the friction potential's gradient
+ * and Hessian (inside and outside the smoothing zone), its Coulomb limit, the closest point
+ * of a triangle in each region. */
+static void test_pieces(void)
+{
+    const double eps = 1e-3, mul = 2.5;
+    const double us[3][2] = {{3e-4, -2e-4}, {2e-3, 1e-3}, {0, 0}};
+    for (int c = 0; c < 3; ++c) {
+        double g[2], H[4];
+        sem_friction_potential(mul, us[c], eps, g, H);
+        for (int k = 0; k < 2; ++k) {
+            double h = 1e-8, up[2] = {us[c][0], us[c][1]}, um[2] = {us[c][0], us[c][1]}, gp[2], gm[2];
+            up[k] += h;
+            um[k] -= h;
+            double fd = (sem_friction_potential(mul, up, eps, gp, NULL) - sem_friction_potential(mul, um, eps, gm, NULL)) /
+                        (2 * h);
+            CHECK_NEAR(g[k], fd, 1e-6 * mul);
+            if (c == 2) continue; /* the Hessian at u = 0 is 2 mu lambda / eps I (below) */
+            for (int j = 0; j < 2; ++j) CHECK_NEAR(H[2 * j + k], (gp[j] - gm[j]) / (2 * h), 1e-4 * mul / eps);
+        }
+        if (c == 1) CHECK_NEAR(sqrt(g[0] * g[0] + g[1] * g[1]), mul, 1e-12); /* sliding: mu lambda */
+        if (c == 2) CHECK(fabs(H[0] - 2 * mul / eps) < 1e-9 && fabs(H[3] - 2 * mul / eps) < 1e-9 && H[1] == 0,
+                          "Hessian at rest");
+    }
+    const double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, cc[3] = {0, 1, 0};
+    sem_tri_closest cl;
+    const double p_face[3] = {0.25, 0.25, -0.5}, p_edge[3] = {0.5, -1, 2}, p_vertex[3] = {2, -1, 0};
+    sem_point_triangle_closest(p_face, a, b, cc, &cl);
+    CHECK(cl.feature == SEM_TRI_FACE && fabs(cl.dist2 - 0.25) < 1e-15 && fabs(cl.bary[1] - 0.25) < 1e-15,
+          "face region");
+    double outward[3] = {0, 0, 1}, n[3];
+    CHECK_NEAR(sem_signed_distance(p_face, cl.point, outward, n), -0.5, 1e-15);
+    CHECK_NEAR(n[2], 1.0, 1e-15);
+    sem_point_triangle_closest(p_edge, a, b, cc, &cl);
+    CHECK(cl.feature == SEM_TRI_EDGE && cl.index == 0 && fabs(cl.dist2 - 5) < 1e-14, "edge region");
+    sem_point_triangle_closest(p_vertex, a, b, cc, &cl);
+    CHECK(cl.feature == SEM_TRI_VERTEX && cl.index == 1 && fabs(cl.dist2 - 2) < 1e-14, "vertex region");
+}
+
 static void write_text(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -450,6 +491,7 @@ int main(int argc, char **argv)
         setenv("SEM_NO_RESTART", "1", 1);
         execv("/proc/self/exe", argv);
     }
+    test_pieces();
     test_scene();
     test_rest(SEM_IMPLICIT_EULER, "rest (implicit Euler)");
     test_rest(SEM_LINEARLY_IMPLICIT_EULER, "rest (linearly implicit Euler)");

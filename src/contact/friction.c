@@ -8,15 +8,13 @@
 double sem_friction_potential(double mu_lambda, const double u[2], double eps, double g[2], double H[4])
 {
     double y = sqrt(u[0] * u[0] + u[1] * u[1]);
-    double f0, f1, f1y, df1; /* f1y = f1(y) / y */
+    double f0, f1y, df1; /* f1(y) / y and f1'(y), f1 = f0' */
     if (y < eps) {
         f0 = -y * y * y / (3 * eps * eps) + y * y / eps + eps / 3;
-        f1 = -y * y / (eps * eps) + 2 * y / eps;
         f1y = -y / (eps * eps) + 2 / eps;
         df1 = -2 * y / (eps * eps) + 2 / eps;
     } else {
         f0 = y;
-        f1 = 1;
         f1y = 1 / y;
         df1 = 0;
     }
@@ -36,7 +34,6 @@ double sem_friction_potential(double mu_lambda, const double u[2], double eps, d
             H[k] = mu_lambda * (f1y * (I - uu[k]) + df1 * uu[k]);
         }
     }
-    (void)f1;
     return mu_lambda * f0;
 }
 

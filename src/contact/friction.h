@@ -18,8 +18,8 @@
 /* D(u) for mu_lambda = mu lambda; g (2) and H (2 x 2 row-major) its gradient and Hessian
  * (either may be NULL). */
 double sem_friction_potential(double mu_lambda, const double u[2], double eps, double g[2], double H[4]);
-/* Two unit vectors T = [t1 t2] (column k at T[k], T[2 + k], T[4 + k]) orthogonal to the
- * unit vector n and to each other. */
+/* Two unit vectors T = [t1 t2], 3 x 2 row-major (coordinate k of t_c at T[2 k + c]),
+ * orthogonal to the unit vector n and to each other. */
 void sem_tangent_basis(const double n[3], double T[6]);
 
 #endif
