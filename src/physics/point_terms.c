@@ -138,27 +138,17 @@ static int term_couplings(const sem_system *s, const sem_point_weight *wt, int c
     return 1;
 }
 
-void sem_system_set_point_terms(sem_system *s, const sem_point_terms *const *lists, const double *scale,
-                                int n_lists)
+/* Adds scale x the terms of t to the values. */
+static void add_terms(sem_system *s, const sem_point_terms *t, double scale, double *val)
 {
-    if (!s->solver) return;
-    double *val = sem_system_values(s);
-    for (int i = 0; i < s->n_couplings; ++i) {
-        const sem_system_coupling *k = &s->couplings[i];
-        size_t n = 9 * sem_group_size(s->objects[k->a], k->ga) * sem_group_size(s->objects[k->b], k->gb);
-        for (size_t e = 0; e < n; ++e)
-            if (s->coupling_map[i][e] >= 0) val[s->coupling_map[i][e]] = 0;
-    }
     int set[MAX_TERM_WEIGHTS], row[MAX_TERM_WEIGHTS], coupling[MAX_TERM_SETS * MAX_TERM_SETS];
-    for (int l = 0; l < n_lists; ++l) {
-    const sem_point_terms *t = lists[l];
     for (int n = 0; n < t->n; ++n) {
         const sem_point_term *term = &t->terms[n];
         const sem_point_weight *wt = t->weights + term->first;
         if (term->count > MAX_TERM_WEIGHTS) continue; /* contact's terms have <= 3 x 64 */
         int m = term_sets(s, term, wt, set);
         int exact = m == 1 || term_couplings(s, wt, term->count, set, m, coupling);
-        double c = scale[l] * (exact ? 1 : m);
+        double c = scale * (exact ? 1 : m);
         for (int i = 0; i < term->count; ++i) {
             const sem_object *o = s->objects[wt[i].object];
             int f = o->free_index[wt[i].ctrl];
@@ -183,7 +173,20 @@ void sem_system_set_point_terms(sem_system *s, const sem_point_terms *const *lis
             }
         }
     }
+}
+
+void sem_system_set_point_terms(sem_system *s, const sem_point_terms *const *lists, const double *scale,
+                                int n_lists)
+{
+    if (!s->solver) return;
+    double *val = sem_system_values(s);
+    for (int i = 0; i < s->n_couplings; ++i) {
+        const sem_system_coupling *k = &s->couplings[i];
+        size_t n = 9 * sem_group_size(s->objects[k->a], k->ga) * sem_group_size(s->objects[k->b], k->gb);
+        for (size_t e = 0; e < n; ++e)
+            if (s->coupling_map[i][e] >= 0) val[s->coupling_map[i][e]] = 0;
     }
+    for (int l = 0; l < n_lists; ++l) add_terms(s, lists[l], scale[l], val);
 }
 
 void sem_point_terms_multiply(const sem_system *s, const sem_point_terms *t, double scale,
