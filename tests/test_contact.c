@@ -62,6 +62,7 @@ static int make(setup *s, int sphere, const double center[3], const double gravi
     sem_preprocess_options po = sem_default_preprocess_options();
     po.rays[0] = po.rays[1] = 4;
     po.points_per_interval = 4;
+    po.q_space_operators = 1; /* contact needs the q-space solvers (point_terms.h) */
     if (sem_preprocess(s->model, &po, &s->disc, &err) != SEM_OK) {
         CHECK(0, "preprocess: %s", err.message);
         return 0;
@@ -71,6 +72,7 @@ static int make(setup *s, int sphere, const double center[3], const double gravi
     wd.integrator = integ;
     wd.dt = 0.01;
     wd.contact.resolution = 8;
+    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
     s->world = sem_world_create(&wd, &err);
     CHECK(s->world != NULL, "world: %s", err.message);
     if (!s->world) return 0;
@@ -145,6 +147,7 @@ static void test_disabled(void)
     sem_world_def wd = sem_default_world_def();
     wd.integrator = SEM_IMPLICIT_EULER;
     wd.contact.disabled = 1;
+    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
     sem_error err;
     s.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
@@ -279,6 +282,7 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     wd.gravity[2] = 0;
     wd.integrator = integ;
     wd.contact.resolution = 8;
+    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
     a.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
     od.model = a.model;

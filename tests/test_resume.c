@@ -163,7 +163,8 @@ static int same_folder(const char *a, const char *b, const char *what)
     return n;
 }
 
-/* summary.json numbers that do not depend on the machine's speed */
+/* summary.json numbers that do not depend on the machine's speed (nor on what a process
+ * took: peak_memory_bytes) */
 static void same_summary(const char *a, const char *b, const char *what)
 {
     char pa[700], pb[700];
@@ -178,7 +179,7 @@ static void same_summary(const char *a, const char *b, const char *what)
     if (ja && jb) {
         static const char *const drop[] = {"mean_step_s", "max_step_s", "mean_factor_s",
                                            "preprocess_s", "preprocess_cached", "output_dir", "usd",
-                                           "glb"};
+                                           "glb", "peak_memory_bytes"};
         for (size_t k = 0; k < sizeof drop / sizeof drop[0]; ++k) {
             cJSON_DeleteItemFromObjectCaseSensitive(ja, drop[k]);
             cJSON_DeleteItemFromObjectCaseSensitive(jb, drop[k]);

@@ -37,7 +37,15 @@
 #define SEM_MAX_TRIM_SEGMENTS 8192             /* knot spans over one part's trim curves */
 
 /* ---- preprocessing (estimated from the model and the settings before any step runs) ---- */
-#define SEM_MAX_PREPROCESS_CONTROL_POINTS 20000 /* the cubes study's largest has 3546 */
+#define SEM_MAX_PREPROCESS_CONTROL_POINTS 20000 /* with the q-space operators (dense blocks
+                                                  over control points): the cubes study's
+                                                  largest has 3546 */
+#define SEM_MAX_STRUCTURED_CONTROL_POINTS 200000 /* without them (the structured solver):
+                                                  the rocket refined to 1e5 dofs has 33,000 */
+#define SEM_MAX_STRUCTURED_COEFFICIENTS 15000  /* 3 n_parts m: the side of the structured
+                                                  solver's dense matrix (1.8 GB at the limit);
+                                                  above, the automatic rule keeps the q-space
+                                                  solvers */
 #define SEM_MAX_BOUNDARY_ENTRIES 1e7           /* boundary samples x control points each
                                                   touches ((degree + 1)^2): J-hat's size */
 #define SEM_MAX_TRIANGLES 4e6                  /* ray-casting tessellation */

@@ -60,6 +60,12 @@ typedef struct sem_preprocess_options {
     double youngs_modulus;   /* for the default gamma; default 1e6 */
     int tessellation;        /* triangle grid cells per knot span per direction; default 16 */
     int threads;             /* 0: OpenMP default */
+    int q_space_operators;   /* 1: also form the control-point-space operators Grad,
+                                Gamma_samples, M and M_eps (the q-space solvers and the operator
+                                tests need them; dense blocks for most models); 0: Gamma only,
+                                which is all the structured solver needs; -1 (default): 1 when
+                                the default world would not use the structured solver
+                                (sem_world_def_structured), else 0 */
 } sem_preprocess_options;
 
 sem_preprocess_options sem_default_preprocess_options(void);
@@ -122,6 +128,8 @@ typedef struct sem_discretization {
     sem_csr Gamma;         /* n_quad x n_ctrl: x(X_p) = Gamma Q (Eq. 12) */
     sem_csr Grad;          /* 3 n_quad x n_ctrl: F_p[d][e] = (Grad[3p+e] . Q[:,d]) (Eq. 15) */
     sem_csr Gamma_samples; /* n_samples x n_ctrl: SEM map at the boundary samples */
+    /* Grad, Gamma_samples, M, M_eps: formed with options.q_space_operators only, else
+     * empty (their rows, no entries) */
     sem_csr M;             /* n_ctrl x n_ctrl, unit density: sum vol Gamma^T Gamma (Eq. 14) */
     sem_csr M_eps;         /* n_ctrl x n_ctrl: sum area (Gamma_s - J_s)^T (Gamma_s - J_s) (Eq. 16),
                               without gamma */
@@ -146,6 +154,8 @@ sem_status sem_discretization_load(const char *path, unsigned long long expected
 sem_status sem_discretization_load_buffer(const char *name, const void *data, size_t size,
                                           unsigned long long expected_hash,
                                           sem_discretization **out, sem_error *err);
+/* Whether options form the q-space operators for this model (resolves -1). */
+int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o);
 /* Hash of a model's geometry (degrees, knots, weights, control points, trims) and options. */
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o);
 

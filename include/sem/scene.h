@@ -150,6 +150,10 @@ typedef struct sem_scene_world_options {
     void *log_user;
     int skip_modes;         /* 1: do not look for zero-energy modes (sem_world_object_modes;
                                one factorization per object) */
+    double memory_available; /* bytes the machine can give the run; > 0: once every object
+                                is preprocessed, and before the world allocates its matrices,
+                                a warning (log level 1) when the estimated peak
+                                (sem_scene_world_estimated_memory) exceeds it; 0: no check */
 } sem_scene_world_options;
 
 sem_scene_world_options sem_default_scene_world_options(void);
@@ -179,6 +183,10 @@ int sem_scene_world_all_cached(const sem_scene_world *sw);
 int sem_scene_world_spurious_modes(const sem_scene_world *sw, int object);
 /* Wall time spent loading models and preprocessing (or reading the cache), seconds. */
 double sem_scene_world_preprocess_seconds(const sem_scene_world *sw);
+/* Estimated peak resident memory of the run, bytes: the program's base and, per object,
+ * sem_world_estimate_memory without its base (objects are preprocessed one after the other,
+ * so the largest preprocessing counts once). */
+double sem_scene_world_estimated_memory(const sem_scene_world *sw);
 
 #ifdef __cplusplus
 }

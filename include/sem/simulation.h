@@ -30,9 +30,11 @@ typedef enum sem_integrator {
 } sem_integrator;
 
 typedef enum sem_solver_choice {
-    SEM_SOLVER_AUTO,   /* a fixed rule: dense up to 500 dofs, CHOLMOD above (reproducible) */
+    SEM_SOLVER_AUTO,   /* a fixed rule: structured when the control points are at least twice the
+                          coefficients (n_parts m), else dense up to 500 dofs, CHOLMOD above */
     SEM_SOLVER_SPARSE, /* CHOLMOD */
-    SEM_SOLVER_DENSE   /* LAPACK dpotrf */
+    SEM_SOLVER_DENSE,  /* LAPACK dpotrf */
+    SEM_SOLVER_STRUCTURED /* part-sparse plus low rank through Pi (Woodbury); no q-space matrix */
 } sem_solver_choice;
 
 /* Messages of a world: level 0 information (Newton's trace, when asked for), 1 warning. */
@@ -69,6 +71,11 @@ typedef struct sem_world_def {
 } sem_world_def;
 
 sem_world_def sem_default_world_def(void);
+/* 1 when a world with these settings solves an object of n_ctrl control points, n_parts
+ * parts and n_basis polynomial terms (4 or 10) with the structured solver (the rule of
+ * SEM_SOLVER_AUTO); its discretization then needs no q-space operators
+ * (sem_preprocess_options.q_space_operators), which the other solvers do. */
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis);
 
 typedef enum sem_prescribe_type {
     SEM_PRESCRIBE_NONE,
@@ -217,6 +224,21 @@ sem_world_counters sem_world_get_counters(const sem_world *world);
 int sem_world_add_collider(sem_world *world, const sem_collider_def *def, sem_error *err);
 /* Contact of the last step (contacts, smallest gap, time). */
 void sem_world_contact_stats(const sem_world *world, sem_contact_stats *stats);
+/* Memory a run of one object needs, in bytes, estimated from its discretization's sizes
+ * (control points, parts, groups, quadrature points, samples, weights) in one cheap pass,
+ * before anything large is allocated. src/physics/memory_estimate.c explains every term. */
+typedef struct sem_memory_estimate {
+    double base;           /* the program and its libraries */
+    double discretization; /* the preprocessed data kept during the run (exact) */
+    double preprocessing;  /* what sem_preprocess holds beyond its result while it runs */
+    double blocks;         /* dense group-pair blocks of M, M_eps, K, K0 and their maps */
+    double assembly;       /* per-point and per-part-pair work of the stiffness */
+    double solver;         /* system matrix and Cholesky factor */
+    double total;          /* base + discretization + max(preprocessing, the three above):
+                              the expected peak resident memory of a run of this object */
+} sem_memory_estimate;
+sem_status sem_world_estimate_memory(const sem_discretization *disc, sem_memory_estimate *out,
+                                     sem_error *err);
 
 #ifdef __cplusplus
 }

@@ -176,7 +176,8 @@ class sem_preprocess_options(Structure):
     _fields_ = [("order", c_int), ("spacing", c_double), ("rays", c_int * 2), ("ray_axis", c_int),
                 ("points_per_interval", c_int), ("alpha", c_double), ("sparsity", c_double),
                 ("weight_threshold", c_double), ("origin_rule", c_int), ("gamma", c_double),
-                ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int)]
+                ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int),
+                ("q_space_operators", c_int)]
 
 
 class sem_preprocess_timings(Structure):
@@ -231,7 +232,8 @@ class sem_scene_world_options(Structure):
     _c_header_ = "scene.h"
     _fields_ = [("cache_dir", c_char_p), ("read_cache", c_int), ("write_cache", c_int),
                 ("cache_max_bytes", c_longlong), ("log", sem_scene_log_fn),
-                ("log_user", c_void_p), ("skip_modes", c_int)]
+                ("log_user", c_void_p), ("skip_modes", c_int),
+                ("memory_available", c_double)]
 
 
 MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,

@@ -79,6 +79,15 @@ int cli_need_values(const char *command, int argc, char **argv, int i, int count
 /* 1 for "--help" / "-h". */
 int cli_is_help(const char *arg);
 
+/* ---- memory (memory.c) ---- */
+/* Bytes the machine can give a run now: $SEM_MEMORY_AVAILABLE_MB when set (for tests), else
+ * MemAvailable of /proc/meminfo, else the physical memory; 0 when unknown. */
+double cli_memory_available(void);
+/* The process's peak resident memory so far (getrusage ru_maxrss), bytes. */
+double cli_peak_memory(void);
+/* "215 MB" or "1.5 GB". */
+void cli_format_bytes(double bytes, char *out, size_t size);
+
 /* ---- progress (progress.c) ---- */
 /* A progress report on stderr for a loop of `total` steps: a redrawn bar when stderr is a
  * terminal, otherwise one line per ~10%. One report at a time (not thread-safe: call from

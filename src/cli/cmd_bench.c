@@ -13,7 +13,9 @@
  * linearly implicit Euler steps (gravity 9.8 m/s^2 along -z, dt 0.01, no collision), after
  * one untimed warm-up step that does the one-off work (solver choice, symbolic analysis);
  * factor = mean time of the one factorization inside those steps
- * (sem_world_last_factor_seconds); Nnz% of the q-space system matrix.
+ * (sem_world_last_factor_seconds); Nnz% of the q-space system matrix; the process's peak
+ * resident memory after the row (getrusage: the rows share one process, so a row's figure
+ * is the largest of the rows so far).
  *
  * Rows whose file is missing are skipped (with a warning). Progress goes to stderr.
  * Exit status: 0 when every available row ran; 1 when one failed or none was found.
@@ -54,6 +56,14 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
         po = sem_default_preprocess_options();
         po.youngs_modulus = r->youngs_modulus;
     }
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -9.8;
+    wd.dt = 0.01;
+    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
+    wd.solver = solver;
+    /* the q-space operators only for the solvers that use them */
+    po.q_space_operators =
+        !sem_world_def_structured(&wd, sem_model_control_points(m), m->n_parts, po.order == 1 ? 4 : 10);
     sem_discretization *d = NULL;
     sem_world *w = NULL;
     for (int k = 0; k < repeat; ++k) {
@@ -66,11 +76,6 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     }
     out->dofs = 3 * d->n_ctrl;
 
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = -9.8;
-    wd.dt = 0.01;
-    wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
-    wd.solver = solver;
     w = sem_world_create(&wd, err);
     if (!w) {
         st = err->status != SEM_OK ? err->status : SEM_ERR_INVALID;
@@ -159,6 +164,7 @@ int cmd_bench(int argc, char **argv)
             if (strcmp(v, "auto") == 0) solver = SEM_SOLVER_AUTO;
             else if (strcmp(v, "sparse") == 0) solver = SEM_SOLVER_SPARSE;
             else if (strcmp(v, "dense") == 0) solver = SEM_SOLVER_DENSE;
+            else if (strcmp(v, "structured") == 0) solver = SEM_SOLVER_STRUCTURED;
             else return cli_usage(CMD, "--solver must be auto, sparse or dense (got '%s')", v);
         } else if (argv[i][0] == '-') return cli_usage(CMD, "unknown option '%s'", argv[i]);
         else return cli_usage(CMD, "unexpected argument '%s'", argv[i]);
@@ -173,9 +179,9 @@ int cmd_bench(int argc, char **argv)
         printf("Table 1: ours / paper (s) and speed-up paper / ours; %d threads; preprocessing phases "
                "the fastest of %d runs, step the mean of %d steps\n",
                omp_get_max_threads(), repeat, steps);
-        printf("%-19s %5s %5s | %-25s | %-25s | %-25s | %-25s | %-25s | %8s | %6s %6s | %8s\n", "example",
+        printf("%-19s %5s %5s | %-25s | %-25s | %-25s | %-25s | %-25s | %8s | %6s %6s | %8s | %7s\n", "example",
                "dofs", "paper", "sample", "quad", "weights", "build Pi", "step", "factor", "Nnz%",
-               "paper", "scene");
+               "paper", "scene", "peak MB");
     }
     /* Warm-up: the first preprocessing of a process pays one-off costs (Embree device,
      * thread pools, page faults) that belong to no row, and the first row used to run
@@ -242,6 +248,9 @@ int cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(o, "factor_s", b.factor_s);
             cJSON_AddNumberToObject(o, "nnz_percent", b.nnz_percent);
             cJSON_AddStringToObject(o, "solver", b.solver);
+            /* the process's peak so far: rows run one after the other in one process, so
+             * this is the largest row up to this one (docs/validation.md, section 5) */
+            cJSON_AddNumberToObject(o, "peak_memory_bytes", cli_peak_memory());
             cJSON *p = cJSON_AddObjectToObject(o, "paper");
             if (p) {
                 cJSON_AddNumberToObject(p, "dofs", r->paper_q);
@@ -259,7 +268,8 @@ int cmd_bench(int argc, char **argv)
             print_cell(b.pre.weights_s, r->paper_weights);
             print_cell(b.pre.build_pi_s, r->paper_build_pi);
             print_cell(b.step_s, r->paper_step);
-            printf(" %8.2e | %6.2f %6.2f | %8.2e\n", b.factor_s, b.nnz_percent, r->paper_nnz, b.pre.scene_s);
+            printf(" %8.2e | %6.2f %6.2f | %8.2e | %7.0f\n", b.factor_s, b.nnz_percent, r->paper_nnz,
+                   b.pre.scene_s, cli_peak_memory() / (1024.0 * 1024.0));
             fflush(stdout);
         }
     }

@@ -225,6 +225,10 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
     cJSON_AddNumberToObject(s, "contact_s", r->steps_timed ? r->contact_sum / r->steps_timed : 0.0);
     cJSON_AddNumberToObject(s, "preprocess_s", sem_scene_world_preprocess_seconds(r->sw));
     cJSON_AddBoolToObject(s, "preprocess_cached", sem_scene_world_all_cached(r->sw));
+    /* the process's peak resident memory until now (getrusage), and what was estimated
+     * before the world was built (sem_scene_world_estimated_memory) */
+    cJSON_AddNumberToObject(s, "peak_memory_bytes", cli_peak_memory());
+    cJSON_AddNumberToObject(s, "estimated_memory_bytes", sem_scene_world_estimated_memory(r->sw));
     cJSON_AddStringToObject(s, "output_dir", r->scene->output_dir);
     if (r->anim && r->scene->write_usd) cJSON_AddStringToObject(s, "usd", sem_animation_usd_path(r->anim));
     if (r->anim && r->scene->write_glb) cJSON_AddStringToObject(s, "glb", sem_animation_glb_path(r->anim));
@@ -486,6 +490,7 @@ int cmd_run(int argc, char **argv)
     wo.cache_max_bytes = cli_cache_max_bytes();
     wo.log = run_log;
     wo.log_user = &quiet;
+    wo.memory_available = cli_memory_available();
     if (sem_scene_world_create(r.scene, &wo, &r.sw, &err) != SEM_OK) {
         cli_fail_error(NULL, &err);
         goto done;
@@ -656,8 +661,10 @@ int cmd_run(int argc, char **argv)
         goto done;
     }
     if (!quiet && !json) {
-        fprintf(stderr, "sem: %lld steps, mean %.3g s per step\n", r.steps,
-                r.steps_timed ? r.step_sum / r.steps_timed : 0.0);
+        char peak[32];
+        cli_format_bytes(cli_peak_memory(), peak, sizeof peak);
+        fprintf(stderr, "sem: %lld steps, mean %.3g s per step, peak memory %s\n", r.steps,
+                r.steps_timed ? r.step_sum / r.steps_timed : 0.0, peak);
         fprintf(stderr,
                 "sem: animation written to %s/: frame_NNNN.igs (NURBS for Rhino/Fusion 360), "
                 "frame_NNNN_mesh.obj (render meshes), animation.usda (open with Blender: File > Import > "

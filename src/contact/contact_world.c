@@ -685,6 +685,13 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
     c->n_fweights = 0;
     c->friction_eps = 0;
     if (!sem_contact_active(c)) return SEM_OK;
+    /* the structured solver (physics/structured.h) has no matrix to take point terms yet:
+     * without the contact Hessian Newton would crawl and the linearly implicit step would
+     * be explicit in the springs */
+    if (s->structured)
+        return sem_error_set(err, SEM_ERR_UNSUPPORTED,
+                             "contact needs the sparse or dense solver for now (integrator.solver); the structured "
+                             "solver does not take contact terms yet");
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");

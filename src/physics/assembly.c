@@ -23,7 +23,7 @@ static int pair_has_points(const sem_object *o, int pr)
 
 /* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
  * part's own basis, b(X - Xbar_i) with s = ref_X - Xbar_i, to the shared one, b(X - ref_X). */
-static void basis_shift(int m, const double s[3], double *T)
+void sem_basis_shift(int m, const double s[3], double *T)
 {
     memset(T, 0, (size_t)m * m * sizeof(double));
     for (int k = 0; k < m; ++k) T[k * m + k] = 1.0;
@@ -67,7 +67,7 @@ static sem_status setup_stiffness(sem_object *o, int assembly_chunk, sem_error *
     for (int i = 0; i < o->n_parts; ++i) {
         const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
         double sh[3] = {o->ref_X[0] - Xb[0], o->ref_X[1] - Xb[1], o->ref_X[2] - Xb[2]}, T[100];
-        basis_shift(m, sh, T);
+        sem_basis_shift(m, sh, T);
         size_t n = sem_group_size(o, d->part_origin[i]);
         double *ps = o->pi_shared[i] = calloc((size_t)ma * n + 1, sizeof(double));
         if (!ps) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
@@ -346,6 +346,11 @@ sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian
         }
     }
     if (!want_hessian) return SEM_OK;
+    if (o->structured) {
+        /* no q-space blocks: the structured solver reads Kz (structured.h) */
+        if (fill) sem_system_set_object(fill->system, fill->object, fill->coef);
+        return SEM_OK;
+    }
     /* K_q blocks = sum over part pairs Pi_a^T Kz Pi_b per coordinate pair. The small dgemm
      * calls run inside our OpenMP threads: OpenBLAS's own threads would only oversubscribe
      * the cores (measured: the rocket's step went from 18 ms to 11 ms), so BLAS is single

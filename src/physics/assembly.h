@@ -52,6 +52,9 @@ sem_status sem_assembly_init(sem_object *o, int assembly_chunk, sem_error *err);
  * undefined (an inverted element, a non-finite state). */
 sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                 const sem_fill_target *fill, sem_error *err);
+/* T (m x m, row-major) with b(y + s) = T b(y): from a part's own basis b(X - Xbar_i),
+ * s = ref_X - Xbar_i, to the shared one b(X - ref_X) (see setup_stiffness in assembly.c). */
+void sem_basis_shift(int m, const double s[3], double *T);
 /* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
  * energies are translation invariant, but evaluated at q far from the origin their
  * round-off grows with |q|; a body that travels (free fall, a thrown object) would then

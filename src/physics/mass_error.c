@@ -5,6 +5,7 @@
  * with the object's matrices.
  */
 #include "assembly.h"
+#include "structured.h"
 
 #include <cblas.h>
 #include <math.h>
@@ -65,6 +66,42 @@ static void add_projected(const sem_object *o, int pa, int pb, const double *X, 
                 nb, 1.0, block, nb);
 }
 
+/* Control points that no boundary sample sees (their basis functions are supported only
+ * where a trim removed the surface) appear in no term of the discretization, so the system
+ * would be singular. Each such point is tied to its own part's polynomial at its rest
+ * position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical control point's
+ * error term (*mean). It vanishes for every affine motion (the control points of an affinely
+ * mapped NURBS are affinely mapped), so the patch test is unaffected. Lists them (control
+ * point, part) in order. */
+static sem_status find_orphans(const sem_object *o, int **ctrl, int **part, int *n, double *mean,
+                               sem_error *err)
+{
+    const sem_csr *J = &o->d->J_hat;
+    *n = 0;
+    *ctrl = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+    *part = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+    double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
+    if (!*ctrl || !*part || !colw) {
+        free(colw);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int r = 0; r < J->n_rows; ++r)
+        for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
+            colw[J->col[e]] += o->d->sample_area[r] * J->val[e] * J->val[e];
+    double mn = 0;
+    for (int c = 0; c < o->n_ctrl; ++c) mn += colw[c];
+    mn /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+    for (int i = 0; i < o->n_parts; ++i)
+        for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
+            if (colw[c] > 1e-10 * mn) continue;
+            (*ctrl)[*n] = c;
+            (*part)[(*n)++] = i;
+        }
+    *mean = mn;
+    free(colw);
+    return SEM_OK;
+}
+
 /* Constant blocks: mass with per-point density, and the error matrix. */
 static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
 {
@@ -106,6 +143,19 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                     for (int l = 0; l < m; ++l) bz[k * m + l] += (diag - off) * ba[k] * bb[l];
             }
     }
+    if (o->structured) {
+        /* the pair blocks are the structured form's Mz and Bz (structured.h) */
+        int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
+        double tie_weight = 0;
+        sem_status st = find_orphans(o, &tie_ctrl, &tie_part, &n_ties, &tie_weight, err);
+        if (st == SEM_OK) st = sem_structured_init(o, Mz, Bz, n_ties, tie_ctrl, tie_part, tie_weight, err);
+        o->n_orphans = n_ties;
+        free(tie_ctrl);
+        free(tie_part);
+        free(Mz);
+        free(Bz);
+        return st;
+    }
     size_t mg = sem_max_group_size(o);
     double *tmp = malloc((size_t)m * mg * sizeof(double));
     if (!tmp) {
@@ -124,53 +174,44 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
     free(tmp);
     free(Mz);
     free(Bz);
-    /* Control points that no boundary sample sees (their basis functions are supported
-     * only where a trim removed the surface) appear in no term of the discretization, so
-     * the system would be singular. Each such point is tied to its own part's polynomial
-     * at its rest position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical
-     * control point's error term. It vanishes for every affine motion (the control points
-     * of an affinely mapped NURBS are affinely mapped), so the patch test is unaffected. */
+    /* the orphan control points' ties (find_orphans) */
     {
-        const sem_csr *J = &o->d->J_hat;
-        double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
-        if (!colw) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        for (int r = 0; r < J->n_rows; ++r)
-            for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
-                colw[J->col[e]] += o->d->sample_area[r] * J->val[e] * J->val[e];
+        int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
         double mean = 0;
-        for (int c = 0; c < o->n_ctrl; ++c) mean += colw[c];
-        mean /= o->n_ctrl > 0 ? o->n_ctrl : 1;
         double *row = malloc(mg * sizeof(double) + 1);
-        if (!row) {
-            free(colw);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        sem_status st = row ? find_orphans(o, &tie_ctrl, &tie_part, &n_ties, &mean, err)
+                            : sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        if (st != SEM_OK) {
+            free(row);
+            free(tie_ctrl);
+            free(tie_part);
+            return st;
         }
         o->n_orphans = 0;
-        for (int i = 0; i < o->n_parts; ++i) {
+        for (int t = 0; t < n_ties; ++t) {
+            int c = tie_ctrl[t], i = tie_part[t];
             int g = o->d->part_origin[i];
             size_t n = sem_group_size(o, g);
             int gp = o->gpair_lookup[(size_t)g * o->n_groups + g];
             if (gp < 0) continue;
-            for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
-                if (colw[c] > 1e-10 * mean) continue;
-                const double *X = o->q0 + 3 * (size_t)c, *Xb = o->d->origin_X + 3 * (size_t)g;
-                double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
-                sem_polynomial_basis(o->d->order, dX, b, NULL);
-                for (size_t l = 0; l < n; ++l) {
-                    double v = 0;
-                    for (int k = 0; k < m; ++k) v += b[k] * o->pi_dense[i][(size_t)k * n + l];
-                    row[l] = -v;
-                }
-                row[o->ctrl_local[c]] += 1.0;
-                double *blk = o->E_blocks + o->gpair_offset[gp];
-                for (size_t a = 0; a < n; ++a)
-                    if (row[a] != 0)
-                        for (size_t bb = 0; bb < n; ++bb) blk[a * n + bb] += mean * row[a] * row[bb];
-                o->n_orphans++;
+            const double *X = o->q0 + 3 * (size_t)c, *Xb = o->d->origin_X + 3 * (size_t)g;
+            double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
+            sem_polynomial_basis(o->d->order, dX, b, NULL);
+            for (size_t l = 0; l < n; ++l) {
+                double v = 0;
+                for (int k = 0; k < m; ++k) v += b[k] * o->pi_dense[i][(size_t)k * n + l];
+                row[l] = -v;
             }
+            row[o->ctrl_local[c]] += 1.0;
+            double *blk = o->E_blocks + o->gpair_offset[gp];
+            for (size_t a = 0; a < n; ++a)
+                if (row[a] != 0)
+                    for (size_t bb = 0; bb < n; ++bb) blk[a * n + bb] += mean * row[a] * row[bb];
+            o->n_orphans++;
         }
         free(row);
-        free(colw);
+        free(tie_ctrl);
+        free(tie_part);
     }
     /* Error matrix (Eq. 16) as a sum of outer products of r_s = Gamma_s - J_s, so it is
      * positive semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J
@@ -292,7 +333,7 @@ sem_status sem_mass_error_init(sem_object *o, sem_error *err)
 {
     sem_status st = setup_points(o, err);
     if (st == SEM_OK) st = setup_constant_blocks(o, err);
-    if (st == SEM_OK) st = setup_constant_csr(o, err);
+    if (st == SEM_OK && !o->structured) st = setup_constant_csr(o, err);
     return st;
 }
 
@@ -308,6 +349,10 @@ double sem_error_energy(sem_object *o, const double *q, double *grad)
 void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
                             const double *x, double *y)
 {
+    if (o->structured) {
+        sem_structured_multiply(o, cM, cE, cK, cD, x, y);
+        return;
+    }
     if (cK == 0 && cD == 0) {
         /* mass and error matrix only: by rows in parallel */
 #pragma omp parallel for schedule(static) num_threads(o->nthreads)

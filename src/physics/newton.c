@@ -174,6 +174,8 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             break;
         }
         st = factorize(w, s, cM, cD, err);
+        /* (the structured solver may find indefiniteness only while solving) */
+        if (st == SEM_OK) st = sem_system_solve(s, fr, fr, err);
         if (st == SEM_ERR_NUMERIC && exact) {
             /* the exact system is not positive definite (e.g. a buckled or unstable
              * equilibrium): project, for the rest of this solve */
@@ -185,9 +187,10 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
                                                err)) != SEM_OK)
                     goto done;
             st = factorize(w, s, cM, cD, err);
+            sem_system_gather_free(s, g, fr);
+            if (st == SEM_OK) st = sem_system_solve(s, fr, fr, err);
         }
         if (st != SEM_OK) goto done;
-        if ((st = sem_system_solve(s, fr, fr, err)) != SEM_OK) goto done;
         memset(dir, 0, n * sizeof(double));
         sem_system_scatter_free(s, fr, dir);
         double slope = 0;

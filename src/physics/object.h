@@ -106,6 +106,11 @@ typedef struct sem_object {
     double elastic_energy;
     double volume, mass;
     double runaway_budget;     /* runaway.c: energy the inputs can supply */
+    /* structured matrices (structured.h): set when the world's solver is structured; then
+     * no q-space block (K_blocks, M_blocks, E_blocks, K0_blocks) and no group pair exists */
+    int structured;
+    struct sem_structured_ops *ops;
+    double *K0z;               /* Kz at rest (Rayleigh damping), structured only */
 } sem_object;
 
 /* Control points in group g. */

@@ -101,6 +101,8 @@ static sem_status setup_pairs(sem_object *o, sem_error *err)
                     o->n_pairs++;
                 }
     }
+    /* structured matrices have no group-pair blocks (structured.h) */
+    if (o->structured) return SEM_OK;
     /* group pairs: from part pairs, and from the error matrix's pattern */
     o->part_pair_gpair = malloc((size_t)o->n_pairs * sizeof(int));
     int gcap = 64;

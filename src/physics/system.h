@@ -49,7 +49,10 @@ typedef struct sem_system {
     int n_free;                /* free control points (3 dofs each) */
     size_t n_dofs;             /* 3 x all control points */
     int **map;                 /* per object: per K block entry, position in the values or -1 */
-    sem_linear_solver *solver; /* NULL when nothing is free */
+    sem_linear_solver *solver; /* NULL when nothing is free (or structured) */
+    int structured;            /* the objects' own structured solvers (structured.h) instead */
+    struct sem_structured_solver **ssolver; /* per object, NULL when it has nothing free */
+    double factor_s;           /* seconds of the last factorization (structured) */
     /* contact: coupling blocks, sorted (a, ga, b, gb); coupling_map[i] holds the position of
      * entry (la, d, d', lb) at (9 la + 3 d + d') |Gb| + lb, or -1 (a pinned point) */
     int n_couplings;
@@ -83,7 +86,10 @@ void sem_system_destroy(sem_system *s);
 void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], double *val);
 /* All values: cM M + cE gamma_k 2 M_eps + cK K + cD K0 for every object k. */
 void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD);
-/* The values to fill (NULL when nothing is free). */
+/* Structured systems: the matrix of object k is c[0] M + 2 c[1] M_eps + c[2] K + c[3] K0 with
+ * its current K (sem_assemble_elastic records it this way when given a fill target). */
+void sem_system_set_object(sem_system *s, int k, const double c[4]);
+/* The values to fill (NULL when nothing is free or the system is structured). */
 double *sem_system_values(sem_system *s);
 sem_status sem_system_factorize(sem_system *s, sem_error *err);
 /* Seconds of the last factorization. */

@@ -4,6 +4,8 @@
  */
 #include "system.h"
 
+#include "structured.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -257,7 +259,22 @@ sem_status sem_system_create_coupled(sem_object **objects, int n_objects, const 
                 s->couplings[kept++] = s->couplings[i];
         s->n_couplings = kept;
     }
-    if (s->n_free > 0) {
+    s->structured = n_objects > 0 && objects[0]->structured;
+    if (s->structured) {
+        s->ssolver = calloc(n, sizeof *s->ssolver);
+        if (!s->ssolver) {
+            sem_system_destroy(s);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        for (int k = 0; k < n_objects; ++k) {
+            if (objects[k]->n_free == 0) continue;
+            sem_status st = sem_structured_solver_create(objects[k], &s->ssolver[k], err);
+            if (st != SEM_OK) {
+                sem_system_destroy(s);
+                return st;
+            }
+        }
+    } else if (s->n_free > 0) {
         sem_status st = build_pattern(s, choice, err);
         if (st != SEM_OK) {
             sem_system_destroy(s);
@@ -279,6 +296,9 @@ void sem_system_destroy(sem_system *s)
         for (int i = 0; i < s->n_couplings; ++i) free(s->coupling_map[i]);
     free(s->coupling_map);
     free(s->couplings);
+    if (s->ssolver)
+        for (int k = 0; k < s->n_objects; ++k) sem_structured_solver_destroy(s->ssolver[k]);
+    free(s->ssolver);
     sem_linear_solver_destroy(s->solver);
     free(s->objects);
     free(s->free_offset);
@@ -310,8 +330,20 @@ void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], doubl
     }
 }
 
+void sem_system_set_object(sem_system *s, int k, const double c[4])
+{
+    if (s->ssolver && s->ssolver[k]) sem_structured_solver_set(s->ssolver[k], c);
+}
+
 void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD)
 {
+    if (s->structured) {
+        for (int k = 0; k < s->n_objects; ++k) {
+            const double c[4] = {cM, cE * s->objects[k]->gamma, cK, cD};
+            sem_system_set_object(s, k, c);
+        }
+        return;
+    }
     double *val = sem_linear_solver_values(s->solver);
     for (int k = 0; k < s->n_objects; ++k) {
         const sem_object *o = s->objects[k];
@@ -328,16 +360,36 @@ double *sem_system_values(sem_system *s)
 
 sem_status sem_system_factorize(sem_system *s, sem_error *err)
 {
+    if (s->structured) {
+        s->factor_s = 0;
+        for (int k = 0; k < s->n_objects; ++k) {
+            if (!s->ssolver[k]) continue;
+            sem_status st = sem_structured_solver_factorize(s->ssolver[k], err);
+            s->factor_s += sem_structured_solver_factor_seconds(s->ssolver[k]);
+            if (st != SEM_OK) return st;
+        }
+        return SEM_OK;
+    }
     return sem_linear_solver_factorize(s->solver, err);
 }
 
 double sem_system_factor_seconds(const sem_system *s)
 {
+    if (s->structured) return s->factor_s;
     return sem_linear_solver_last_factor_seconds(s->solver);
 }
 
 sem_status sem_system_solve(sem_system *s, const double *b, double *x, sem_error *err)
 {
+    if (s->structured) {
+        for (int k = 0; k < s->n_objects; ++k) {
+            if (!s->ssolver[k]) continue;
+            size_t off = 3 * (size_t)s->free_offset[k];
+            sem_status st = sem_structured_solver_solve(s->ssolver[k], b + off, x + off, err);
+            if (st != SEM_OK) return st;
+        }
+        return SEM_OK;
+    }
     return sem_linear_solver_solve(s->solver, b, x, err);
 }
 

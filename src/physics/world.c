@@ -26,6 +26,8 @@
 #include "runaway.h"
 #include "loads.h"
 #include "system.h"
+#include "sem/limits.h"
+#include "structured.h"
 
 sem_world_def sem_default_world_def(void)
 {
@@ -127,6 +129,8 @@ static void object_destroy(sem_object *o)
     free(o->me_M);
     free(o->me_E);
     free(o->K0_blocks);
+    free(o->K0z);
+    sem_structured_free(o);
     free(o->f_gravity);
     free(o->pinned);
     free(o->presc_index);
@@ -160,6 +164,14 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
         if (k >= 0 && k < def->n_part_materials) return &o->part_mats[k];
     }
     return &o->def.material;
+}
+
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis)
+{
+    size_t r0 = (size_t)n_parts * (size_t)n_basis;
+    return def->solver == SEM_SOLVER_STRUCTURED ||
+           (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && n_ctrl >= 2 * r0 &&
+            3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS);
 }
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
@@ -252,10 +264,22 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_object_free_dofs(o, err)) != SEM_OK) goto fail;
     /* error stiffness: the object's, else the discretization's default */
     o->gamma = def->gamma > 0 ? def->gamma : d->gamma;
+    /* the structured solver (structured.h) when asked, and by the fixed rule of
+     * SEM_SOLVER_AUTO: when the coefficient space (n_parts m per coordinate) is at most half
+     * the control points, where its factorization is far cheaper than the q-space one (the
+     * objects of one system must agree, so solving together keeps the q-space solvers) */
+    o->structured = sem_world_def_structured(&w->def, (size_t)o->n_ctrl, o->n_parts, o->m);
+    if (!o->structured && sem_csr_nnz(&d->M) == 0 && o->n_ctrl > 0) {
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "the %s solver needs the q-space operators: preprocess with "
+                           "q_space_operators (or use the structured solver)",
+                           w->def.solver == SEM_SOLVER_DENSE ? "dense" : "sparse");
+        goto fail;
+    }
+    o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
     if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;
-    o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     o->grad_z_share =
         malloc(((size_t)GRADIENT_SHARES * o->n_parts * o->ma * 3 + 1) * sizeof(double));
     o->qc = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
@@ -266,7 +290,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
     if ((st = sem_assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
-    memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
+    if (o->structured)
+        memcpy(o->K0z, o->Kz, (size_t)o->n_pairs * 9 * o->ma * o->ma * sizeof(double));
+    else
+        memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
     /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
     {
         double com[3] = {0, 0, 0};
@@ -360,6 +387,7 @@ sem_world_counters sem_world_get_counters(const sem_world *w) { return w->counte
 
 const char *sem_world_solver_name(const sem_world *w, int i)
 {
+    if (w->objects[i]->structured) return "structured";
     const sem_linear_solver *solver = w->objects[i]->system->solver;
     return solver ? sem_linear_solver_name(solver) : "none";
 }
@@ -367,6 +395,8 @@ const char *sem_world_solver_name(const sem_world *w, int i)
 double sem_world_object_nnz_percent(const sem_world *w, int i)
 {
     const sem_object *o = w->objects[i];
+    /* structured: no q-space matrix exists; the pattern it would have */
+    if (o->structured) return o->d->stiffness_nnz_percent;
     /* full q-space pattern: group-pair blocks x 9 */
     double nnz = 9.0 * (double)o->gpair_offset[o->n_gpairs];
     double n = 3.0 * o->n_ctrl;

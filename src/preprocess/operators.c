@@ -342,6 +342,49 @@ static sem_status union_rows_of_points(const sem_csr *Gd, int rows_per_point, se
 }
 
 /* 1 when, for every part, cols(Pi row i*m) is inside the union of cols(Pi rows i*m+k, k>0). */
+/* An empty n_rows x n_cols matrix (row starts only). */
+static sem_status empty_rows(sem_csr *A, int n_rows, int n_cols)
+{
+    memset(A, 0, sizeof *A);
+    A->row_start = calloc((size_t)n_rows + 1, sizeof(int));
+    if (!A->row_start) return SEM_ERR_NOMEM;
+    A->n_rows = n_rows;
+    A->n_cols = n_cols;
+    return SEM_OK;
+}
+
+/* Nnz% without forming M: every row of Pi_i spans the control points of part i's origin
+ * group, so the pattern of Pi^T (G^T G) Pi is the union of |Ga| x |Gb| blocks over the
+ * origin pairs of the parts that share a quadrature point (the constant rows' columns are
+ * the other rows' columns too: constant_rows_covered, below). */
+static double group_pattern_percent(const sem_discretization *d)
+{
+    int ng = d->n_origins;
+    if (ng <= 0 || d->n_ctrl <= 0) return 0;
+    unsigned char *pair = calloc((size_t)ng * ng, 1);
+    double *size = calloc((size_t)ng, sizeof(double));
+    if (!pair || !size) {
+        free(pair);
+        free(size);
+        return 0;
+    }
+    /* a group's control points: those of its parts */
+    for (int i = 0; i < d->n_parts; ++i)
+        size[d->part_origin[i]] += d->part_ctrl_offset[i + 1] - d->part_ctrl_offset[i];
+    const sem_csr *W = &d->W;
+    for (int p = 0; p < W->n_rows; ++p)
+        for (int a = W->row_start[p]; a < W->row_start[p + 1]; ++a)
+            for (int b = W->row_start[p]; b < W->row_start[p + 1]; ++b)
+                pair[(size_t)d->part_origin[W->col[a]] * ng + d->part_origin[W->col[b]]] = 1;
+    double nnz = 0;
+    for (int a = 0; a < ng; ++a)
+        for (int b = 0; b < ng; ++b)
+            if (pair[(size_t)a * ng + b]) nnz += size[a] * size[b];
+    free(pair);
+    free(size);
+    return 100.0 * nnz / ((double)d->n_ctrl * (double)d->n_ctrl);
+}
+
 static int constant_rows_covered(const sem_discretization *d)
 {
     const sem_csr *Pi = &d->Pi;
@@ -425,11 +468,22 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
         }                                                                                  \
     } while (0)
 
-    /* Eq. 12-13 and 15 */
+    /* Eq. 12-13 */
     TRY(build_poly_rows(d, &d->W, d->quad_X, 1, 0, &G));
+    TRY(csr_product(&G, &d->Pi, &d->Gamma, 0, NULL));
+    if (!o || !o->q_space_operators) {
+        /* Gamma only: the rest are dense blocks over control points that the structured
+         * solver never forms (physics/structured.h); they stay empty, with their rows */
+        TRY(empty_rows(&d->Grad, 3 * d->n_quad, d->n_ctrl));
+        TRY(empty_rows(&d->Gamma_samples, d->n_samples, d->n_ctrl));
+        TRY(empty_rows(&d->M, d->n_ctrl, d->n_ctrl));
+        TRY(empty_rows(&d->M_eps, d->n_ctrl, d->n_ctrl));
+        d->stiffness_nnz_percent = group_pattern_percent(d);
+        goto gamma;
+    }
+    /* Eq. 15 */
     TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 0, &Gd));
     TRY(build_poly_rows(d, &d->W_samples, d->sample_X, 1, 0, &Gs));
-    TRY(csr_product(&G, &d->Pi, &d->Gamma, 0, NULL));
     TRY(csr_product(&Gd, &d->Pi, &d->Grad, 0, NULL));
     TRY(csr_product(&Gs, &d->Pi, &d->Gamma_samples, 0, NULL));
 
@@ -478,6 +532,7 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
         d->stiffness_nnz_percent = 100.0 * (double)nnz / ((double)d->n_ctrl * (double)d->n_ctrl);
     }
 
+gamma:
     /* default gamma = kappa E / L (Sec. 7.6; see the file comment) */
     {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -69,6 +69,7 @@ sem_preprocess_options sem_default_preprocess_options(void)
     o.youngs_modulus = 1e6;
     o.tessellation = 16;
     o.threads = 0;
+    o.q_space_operators = -1;
     return o;
 }
 
@@ -190,6 +191,15 @@ static void hash_loop(fnv *f, const sem_trim_loop *l)
     for (int k = 0; k < l->n_curves && l->curves; ++k) hash_curve(f, &l->curves[k]);
 }
 
+int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o)
+{
+    if (o->q_space_operators >= 0) return o->q_space_operators != 0;
+    /* the rule of SEM_SOLVER_AUTO for a default world (sem_world_def_structured) */
+    size_t n_ctrl = model ? sem_model_control_points(model) : 0;
+    size_t n_parts = model ? (size_t)model->n_parts : 0, m = o->order == 1 ? 4 : 10;
+    return n_ctrl < 2 * n_parts * m || 3 * n_parts * m > SEM_MAX_STRUCTURED_COEFFICIENTS;
+}
+
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o)
 {
     fnv f;
@@ -232,6 +242,7 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
         fnv_doubles(&f, v, 6);
         fnv_int(&f, o->tessellation);
         fnv_int(&f, o->origin_rule);
+        fnv_int(&f, sem_preprocess_q_space(model, o));
     }
     return (unsigned long long)f.h;
 }
@@ -328,6 +339,31 @@ static double spans_in_use(int degree, int n, const double *knots, double t0, do
     return spans;
 }
 
+/* Triangles of the ray-casting tessellation at `tessellation` cells per knot span. */
+static double tessellation_triangles(const sem_model *model, int tessellation)
+{
+    double triangles = 0;
+    for (int i = 0; i < model->n_parts; ++i) {
+        const sem_surface *s = &model->parts[i].surface;
+        double su = spans_in_use(s->degree_u, s->n_u, s->knots_u, s->u0, s->u1);
+        double sv = spans_in_use(s->degree_v, s->n_v, s->knots_v, s->v0, s->v1);
+        triangles += 2.0 * su * sv * tessellation * tessellation;
+    }
+    return triangles;
+}
+
+/* The tessellation is per knot span, so a model with many small spans (a refined model:
+ * `sem refine`) would get a mesh far finer than its shape needs; above SEM_MAX_TRIANGLES the
+ * cells per span are lowered until the mesh has about SEM_MAX_TRIANGLES / 4 triangles (at
+ * least one cell per span). */
+static int fitted_tessellation(const sem_model *model, int tessellation)
+{
+    double t = tessellation_triangles(model, tessellation);
+    if (t <= SEM_MAX_TRIANGLES) return tessellation;
+    int fit = (int)floor(tessellation * sqrt(0.25 * SEM_MAX_TRIANGLES / t));
+    return fit < 1 ? 1 : fit;
+}
+
 /* What the settings and the model would make the steps build, estimated before any of it
  * is built (sem/limits.h): a small file can hold a surface of degree 31 whose boundary
  * samples each touch 1024 control points (3.6 GB of J-hat for a 70 KB file), and a ray grid
@@ -353,14 +389,18 @@ static sem_status check_sizes(const sem_model *model, const sem_preprocess_optio
             nv = fmax(nv, 24 + 2 * pv);
         }
         entries += nu * nv * (s->degree_u + 1) * (s->degree_v + 1);
-        triangles += 2.0 * su * sv * o->tessellation * o->tessellation;
         ctrl += (double)s->n_u * s->n_v;
     }
-    if (ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+    if (sem_preprocess_q_space(model, o) && ctrl > SEM_MAX_PREPROCESS_CONTROL_POINTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
+                                                   "with the q-space operators takes at most %d "
+                                                   "(limit SEM_MAX_PREPROCESS_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+    if (ctrl > SEM_MAX_STRUCTURED_CONTROL_POINTS)
         return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
                                                    "takes at most %d (limit "
-                                                   "SEM_MAX_PREPROCESS_CONTROL_POINTS)",
-                             ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+                                                   "SEM_MAX_STRUCTURED_CONTROL_POINTS)",
+                             ctrl, SEM_MAX_STRUCTURED_CONTROL_POINTS);
     if (entries > SEM_MAX_BOUNDARY_ENTRIES)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "boundary sampling would store %.3g basis values (samples times "
@@ -368,11 +408,13 @@ static sem_status check_sizes(const sem_model *model, const sem_preprocess_optio
                              "SEM_MAX_BOUNDARY_ENTRIES = %.3g): lower the surfaces' degree or "
                              "knot count",
                              entries, (double)SEM_MAX_BOUNDARY_ENTRIES);
+    int tess = fitted_tessellation(model, o->tessellation);
+    triangles = tessellation_triangles(model, tess);
     if (triangles > SEM_MAX_TRIANGLES)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "tessellation %d would make %.3g triangles (limit "
-                             "SEM_MAX_TRIANGLES = %.3g): lower the tessellation",
-                             o->tessellation, triangles, (double)SEM_MAX_TRIANGLES);
+                             "SEM_MAX_TRIANGLES = %.3g): the model has too many knot spans",
+                             tess, triangles, (double)SEM_MAX_TRIANGLES);
     double points = (double)o->rays[0] * o->rays[1] * o->points_per_interval;
     if (points > SEM_MAX_QUADRATURE_POINTS)
         return sem_error_set(err, SEM_ERR_INVALID,
@@ -415,6 +457,8 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     d->order = o.order;
     d->n_basis = o.order == 1 ? 4 : 10;
     d->model_hash = sem_preprocess_hash(model, &o);
+    o.tessellation = fitted_tessellation(model, o.tessellation);
+    o.q_space_operators = sem_preprocess_q_space(model, &o);
 
     double t0 = omp_get_wtime();
     st = sem_step_sample(model, d, err);

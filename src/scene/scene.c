@@ -879,7 +879,8 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
             if (!strcmp(so->valuestring, "auto")) s->world.solver = SEM_SOLVER_AUTO;
             else if (!strcmp(so->valuestring, "sparse")) s->world.solver = SEM_SOLVER_SPARSE;
             else if (!strcmp(so->valuestring, "dense")) s->world.solver = SEM_SOLVER_DENSE;
-            else return fail(c, "integrator.solver", "must be auto, sparse or dense");
+            else if (!strcmp(so->valuestring, "structured")) s->world.solver = SEM_SOLVER_STRUCTURED;
+            else return fail(c, "integrator.solver", "must be auto, structured, sparse or dense");
         }
     }
     if ((st = get_int(c, root, "frames", "scene", &s->frames)) != SEM_OK) return st;

@@ -7,6 +7,9 @@
  * a world made from the scene's world settings. Everything the world points into (models,
  * discretizations, pin flags, material tables) is owned here and lives as long as the
  * world, so any program - the command line, a viewer, a binding - runs a scene the same way.
+ * Every object is preprocessed before any is added to the world, so that the run's memory
+ * can be estimated (and a run too large for the machine announced) before the world
+ * allocates the matrices (sem_world_estimate_memory).
  *
  * The cache folder is a setting (the command line picks it from the environment); nothing
  * here reads the environment or prints: information and warnings go to the log callback.
@@ -37,6 +40,7 @@ struct sem_scene_world {
     int *spurious;             /* per object: zero-energy modes, -1 not looked for */
     int all_cached;
     double preprocess_s;
+    double estimated_memory;   /* bytes (sem_scene_world_estimated_memory) */
 };
 
 sem_scene_world_options sem_default_scene_world_options(void)
@@ -70,6 +74,16 @@ static sem_status prefix_error(sem_error *err, sem_status st, const char *name, 
     char msg[sizeof err->message];
     snprintf(msg, sizeof msg, "%s", err->message);
     return sem_error_set(err, st, "%s: objects[%d]%s%s", name, i, sep, msg);
+}
+
+/* The scene's world settings. Contact: the structured solver takes no contact terms yet
+ * (point_terms.h), so a scene where contact can happen (colliders, or two objects or more)
+ * keeps the q-space solvers, as objects solved together do. */
+static sem_world_def scene_world_def(const sem_scene *scene)
+{
+    sem_world_def d = scene->world;
+    if (!d.contact.disabled && (scene->n_colliders > 0 || scene->n_objects >= 2)) d.advanced.solve_together = 1;
+    return d;
 }
 
 /* Preprocesses, or loads from the cache; *cached tells which. */
@@ -122,7 +136,6 @@ void sem_scene_world_destroy(sem_scene_world *sw)
     free(sw);
 }
 
-/* Builds object i and adds it to the world. */
 /* Zero-energy modes of object i: a warning naming the parts that are not held. */
 static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scene_world_options *o,
                               sem_error *err)
@@ -167,8 +180,9 @@ static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scen
     return SEM_OK;
 }
 
-static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
-                               sem_error *err)
+/* Loads object i's model and preprocesses it (or reads the cache). */
+static sem_status prepare_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
+                                 sem_error *err)
 {
     const sem_scene *scene = sw->scene;
     const char *name = scene->path[0] ? scene->path : "default scene";
@@ -185,7 +199,12 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
     logf_(o, 0, "object %d: %d parts, %zu dofs; preprocessing...", i, model->n_parts,
           3 * sem_model_control_points(model));
     int cached = 0;
-    st = preprocess_cached(model, &so->sem, o, &sw->discs[i], &cached, err);
+    /* the q-space operators only for the solvers that use them */
+    sem_preprocess_options popt = so->sem;
+    sem_world_def wdef = scene_world_def(scene);
+    popt.q_space_operators = !sem_world_def_structured(&wdef, sem_model_control_points(model),
+                                                       model->n_parts, popt.order == 1 ? 4 : 10);
+    st = preprocess_cached(model, &popt, o, &sw->discs[i], &cached, err);
     if (st != SEM_OK) return prefix_error(err, st, name, i, ": ");
     sw->all_cached &= cached;
     logf_(o, 0, "object %d: %s: %d quadrature points, volume %.6g", i,
@@ -199,7 +218,43 @@ static sem_status build_object(sem_scene_world *sw, int i, const sem_scene_world
                   "of its own and moves with the points nearest it (a smaller sem.spacing gives it its own)",
                   i, k, model->parts[k].name[0] ? " (" : "", model->parts[k].name,
                   model->parts[k].name[0] ? ")" : "");
+    return SEM_OK;
+}
 
+/* The run's estimated peak memory (sem_scene_world_estimated_memory), and the warning when
+ * it exceeds what the machine has: before the world allocates the objects' matrices, which
+ * is where a run that does not fit would be killed. */
+static sem_status check_memory(sem_scene_world *sw, const sem_scene_world_options *o, sem_error *err)
+{
+    double base = 0, kept = 0, largest_transient = 0;
+    for (int i = 0; i < sw->n; ++i) {
+        sem_memory_estimate e;
+        sem_status st = sem_world_estimate_memory(sw->discs[i], &e, err);
+        if (st != SEM_OK) return st;
+        base = e.base;
+        /* what stays until the end, and the largest of what the preprocessing holds only
+         * while it runs: objects are preprocessed one after the other */
+        double run = e.blocks + e.assembly + e.solver;
+        kept += e.discretization + run;
+        if (e.preprocessing - run > largest_transient) largest_transient = e.preprocessing - run;
+    }
+    sw->estimated_memory = base + kept + largest_transient;
+    const double gb = 1024.0 * 1024.0 * 1024.0;
+    if (o->memory_available > 0 && sw->estimated_memory > o->memory_available)
+        logf_(o, 1, "this run needs about %.3g GB and the machine has %.3g GB available",
+              sw->estimated_memory / gb, o->memory_available / gb);
+    return SEM_OK;
+}
+
+/* Adds object i (preprocessed by prepare_object) to the world. */
+static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
+                             sem_error *err)
+{
+    const sem_scene *scene = sw->scene;
+    const char *name = scene->path[0] ? scene->path : "default scene";
+    const sem_scene_object *so = &scene->objects[i];
+    const sem_model *model = sw->models[i];
+    sem_status st;
     if ((st = sem_scene_object_pins(so, model, &sw->pins[i], err)) != SEM_OK ||
         (st = sem_scene_object_part_materials(so, model, &sw->part_material[i], &sw->materials[i],
                                               err)) != SEM_OK ||
@@ -287,7 +342,8 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    sw->world = sem_world_create(&scene->world, err);
+    sem_world_def wdef = scene_world_def(scene);
+    sw->world = sem_world_create(&wdef, err);
     if (!sw->world) {
         st = err ? err->status : SEM_ERR_INVALID;
         if (err && scene->path[0] && !strstr(err->message, scene->path)) {
@@ -303,8 +359,11 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
     sw->all_cached = 1;
     double t0 = omp_get_wtime();
     for (int i = 0; i < sw->n; ++i)
-        if ((st = build_object(sw, i, &o, err)) != SEM_OK) goto fail;
+        if ((st = prepare_object(sw, i, &o, err)) != SEM_OK) goto fail;
     sw->preprocess_s = omp_get_wtime() - t0;
+    if ((st = check_memory(sw, &o, err)) != SEM_OK) goto fail;
+    for (int i = 0; i < sw->n; ++i)
+        if ((st = add_object(sw, i, &o, err)) != SEM_OK) goto fail;
     *out = sw;
     return SEM_OK;
 fail:
@@ -350,4 +409,9 @@ int sem_scene_world_spurious_modes(const sem_scene_world *sw, int object)
 double sem_scene_world_preprocess_seconds(const sem_scene_world *sw)
 {
     return sw ? sw->preprocess_s : 0.0;
+}
+
+double sem_scene_world_estimated_memory(const sem_scene_world *sw)
+{
+    return sw ? sw->estimated_memory : 0.0;
 }

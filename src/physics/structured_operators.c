@@ -1,0 +1,383 @@
+/*
+ * structured_operators.c - an object's matrices as part-sparse terms plus products through
+ * Pi (structured.h): the sample rows of the error matrix, P, dense coefficient-space Mz, Bb
+ * and Bz, and the products with M, M_eps, K and K0 that never form a q-space matrix.
+ *
+ * Products are summed in a fixed order whatever the thread count: P x by rows (one part's
+ * rows per task), P^T y by groups (every control point is in one group, and a group sums its
+ * parts in order), the sample residuals by samples, and their scatter serially.
+ */
+#include "structured.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "assembly.h"
+
+void sem_structured_free(sem_object *o)
+{
+    sem_structured_ops *s = o->ops;
+    if (!s) return;
+    free(s->p_start);
+    free(s->p_col);
+    free(s->p_val);
+    free(s->area);
+    free(s->j_start);
+    free(s->j_col);
+    free(s->j_val);
+    free(s->g_start);
+    free(s->g_idx);
+    free(s->g_val);
+    free(s->Mz);
+    free(s->Bb);
+    free(s->Bz);
+    free(s);
+    o->ops = NULL;
+}
+
+/* P from pi_dense: part i's rows over its group's control points (group order). */
+static sem_status build_P(sem_object *o, sem_structured_ops *s, sem_error *err)
+{
+    int m = o->m, r0 = s->r0;
+    s->p_start = malloc(((size_t)r0 + 1) * sizeof(int));
+    if (!s->p_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    s->p_start[0] = 0;
+    for (int i = 0; i < o->n_parts; ++i) {
+        size_t n = sem_group_size(o, o->d->part_origin[i]);
+        for (int k = 0; k < m; ++k) s->p_start[i * m + k + 1] = s->p_start[i * m + k] + (int)n;
+    }
+    size_t nnz = (size_t)s->p_start[r0];
+    s->p_col = malloc((nnz + 1) * sizeof(int));
+    s->p_val = malloc((nnz + 1) * sizeof(double));
+    if (!s->p_col || !s->p_val) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for Pi");
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = o->d->part_origin[i];
+        size_t n = sem_group_size(o, g);
+        const int *ctrl = o->group_ctrl + o->group_start[g];
+        for (int k = 0; k < m; ++k) {
+            size_t at = (size_t)s->p_start[i * m + k];
+            memcpy(s->p_col + at, ctrl, n * sizeof(int));
+            memcpy(s->p_val + at, o->pi_dense[i] + (size_t)k * n, n * sizeof(double));
+        }
+    }
+    return SEM_OK;
+}
+
+/* The sample rows (boundary samples, then ties) and Bb. */
+static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties, const int *tie_ctrl,
+                                const int *tie_part, double tie_weight, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *J = &d->J_hat, *Ws = &d->W_samples;
+    int m = o->m, ns = d->n_samples, nr = ns + n_ties, r0 = s->r0;
+    s->n_rows = nr;
+    s->area = malloc(((size_t)nr + 1) * sizeof(double));
+    s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
+    s->g_start = malloc(((size_t)nr + 1) * sizeof(int));
+    double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
+    int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
+    if (!s->area || !s->j_start || !s->g_start || !part_mean || !part_count) {
+        free(part_mean);
+        free(part_count);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    /* every sample keeps at least 5 % of its part's mean weight (a collapsed edge; see
+     * mass_error.c) */
+    for (int r = 0; r < ns; ++r) {
+        part_mean[d->sample_part[r]] += d->sample_area[r];
+        part_count[d->sample_part[r]]++;
+    }
+    for (int i = 0; i < o->n_parts; ++i)
+        if (part_count[i]) part_mean[i] /= part_count[i];
+    for (int r = 0; r < ns; ++r) s->area[r] = fmax(d->sample_area[r], 0.05 * part_mean[d->sample_part[r]]);
+    for (int t = 0; t < n_ties; ++t) s->area[ns + t] = tie_weight;
+    free(part_mean);
+    free(part_count);
+    s->j_start[0] = s->g_start[0] = 0;
+    for (int r = 0; r < ns; ++r) {
+        s->j_start[r + 1] = s->j_start[r] + (J->row_start[r + 1] - J->row_start[r]);
+        s->g_start[r + 1] = s->g_start[r] + m * (Ws->row_start[r + 1] - Ws->row_start[r]);
+    }
+    for (int t = 0; t < n_ties; ++t) {
+        s->j_start[ns + t + 1] = s->j_start[ns + t] + 1;
+        s->g_start[ns + t + 1] = s->g_start[ns + t] + m;
+    }
+    size_t nj = (size_t)s->j_start[nr], ng = (size_t)s->g_start[nr];
+    s->j_col = malloc((nj + 1) * sizeof(int));
+    s->j_val = malloc((nj + 1) * sizeof(double));
+    s->g_idx = malloc((ng + 1) * sizeof(int));
+    s->g_val = malloc((ng + 1) * sizeof(double));
+    s->Bb = calloc((size_t)r0 * r0 + 1, sizeof(double));
+    if (!s->j_col || !s->j_val || !s->g_idx || !s->g_val || !s->Bb)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the error matrix's samples");
+    memcpy(s->j_col, J->col, (size_t)J->row_start[ns] * sizeof(int));
+    memcpy(s->j_val, J->val, (size_t)J->row_start[ns] * sizeof(double));
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < ns; ++r) {
+        int at = s->g_start[r];
+        for (int e = Ws->row_start[r]; e < Ws->row_start[r + 1]; ++e) {
+            int i = Ws->col[e];
+            const double *X = d->sample_X + 3 * (size_t)r, *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+            double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
+            sem_polynomial_basis(d->order, dX, b, NULL);
+            for (int k = 0; k < m; ++k) {
+                s->g_idx[at] = i * m + k;
+                s->g_val[at++] = Ws->val[e] * b[k];
+            }
+        }
+    }
+    for (int t = 0; t < n_ties; ++t) {
+        int c = tie_ctrl[t], i = tie_part[t], r = ns + t;
+        s->j_col[s->j_start[r]] = c;
+        s->j_val[s->j_start[r]] = 1.0;
+        const double *X = o->q0 + 3 * (size_t)c, *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+        double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
+        sem_polynomial_basis(d->order, dX, b, NULL);
+        for (int k = 0; k < m; ++k) {
+            s->g_idx[s->g_start[r] + k] = i * m + k;
+            s->g_val[s->g_start[r] + k] = b[k];
+        }
+    }
+    /* Bb = sum_s a_s g_s^T g_s, by rows of Bb in parallel (each row sums samples in order) */
+    for (int r = 0; r < nr; ++r)
+        for (int x = s->g_start[r]; x < s->g_start[r + 1]; ++x) {
+            double ax = s->area[r] * s->g_val[x];
+            double *row = s->Bb + (size_t)s->g_idx[x] * r0;
+            for (int y = s->g_start[r]; y < s->g_start[r + 1]; ++y) row[s->g_idx[y]] += ax * s->g_val[y];
+        }
+    return SEM_OK;
+}
+
+/* Pair blocks (n_pairs x m x m, own bases) to a dense r0 x r0 matrix. */
+static double *dense_from_pairs(const sem_object *o, const double *pairs, int r0)
+{
+    double *D = calloc((size_t)r0 * r0 + 1, sizeof(double));
+    if (!D || !pairs) return D;
+    int m = o->m;
+    for (int k = 0; k < o->n_pairs; ++k) {
+        int a = o->pair_a[k], b = o->pair_b[k];
+        const double *blk = pairs + (size_t)k * m * m;
+        for (int x = 0; x < m; ++x)
+            for (int y = 0; y < m; ++y) D[(size_t)(a * m + x) * r0 + (size_t)(b * m + y)] += blk[x * m + y];
+    }
+    return D;
+}
+
+sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
+                               int n_ties, const int *tie_ctrl, const int *tie_part,
+                               double tie_weight, sem_error *err)
+{
+    sem_structured_ops *s = calloc(1, sizeof *s);
+    if (!s) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    o->ops = s;
+    s->r0 = o->n_parts * o->m;
+    sem_status st = build_P(o, s, err);
+    if (st == SEM_OK) st = build_samples(o, s, n_ties, tie_ctrl, tie_part, tie_weight, err);
+    if (st != SEM_OK) return st;
+    s->Mz = dense_from_pairs(o, Mz_pairs, s->r0);
+    s->Bz = dense_from_pairs(o, Bz_pairs, s->r0);
+    o->K0z = malloc(((size_t)o->n_pairs * 9 * o->ma * o->ma + 1) * sizeof(double));
+    if (!s->Mz || !s->Bz || !o->K0z)
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coefficient-space matrices");
+    return SEM_OK;
+}
+
+/* yz = P x (r0 x 3, interleaved), x over all control points. */
+static void apply_P(const sem_object *o, const double *x, double *yz)
+{
+    const sem_structured_ops *s = o->ops;
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+    for (int r = 0; r < s->r0; ++r) {
+        double a0 = 0, a1 = 0, a2 = 0;
+        for (int e = s->p_start[r]; e < s->p_start[r + 1]; ++e) {
+            const double *xc = x + 3 * (size_t)s->p_col[e];
+            double v = s->p_val[e];
+            a0 += v * xc[0];
+            a1 += v * xc[1];
+            a2 += v * xc[2];
+        }
+        yz[3 * r + 0] = a0;
+        yz[3 * r + 1] = a1;
+        yz[3 * r + 2] = a2;
+    }
+}
+
+/* y += P^T yz, group by group (a control point belongs to one group). */
+static void apply_Pt(const sem_object *o, const double *yz, double *y)
+{
+    const sem_structured_ops *s = o->ops;
+    int m = o->m;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
+    for (int g = 0; g < o->n_groups; ++g)
+        for (int i = 0; i < o->n_parts; ++i) {
+            if (o->d->part_origin[i] != g) continue;
+            for (int k = 0; k < m; ++k) {
+                int r = i * m + k;
+                const double *z = yz + 3 * (size_t)r;
+                for (int e = s->p_start[r]; e < s->p_start[r + 1]; ++e) {
+                    double *yc = y + 3 * (size_t)s->p_col[e];
+                    double v = s->p_val[e];
+                    yc[0] += v * z[0];
+                    yc[1] += v * z[1];
+                    yc[2] += v * z[2];
+                }
+            }
+        }
+}
+
+/* out += c D yz for a dense r0 x r0 D (same for each coordinate). */
+static void dense_multiply(const sem_object *o, const double *D, double c, const double *yz, double *out)
+{
+    int r0 = o->ops->r0;
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+    for (int r = 0; r < r0; ++r) {
+        const double *row = D + (size_t)r * r0;
+        double a0 = 0, a1 = 0, a2 = 0;
+        for (int c2 = 0; c2 < r0; ++c2) {
+            double v = row[c2];
+            if (v == 0) continue;
+            a0 += v * yz[3 * c2 + 0];
+            a1 += v * yz[3 * c2 + 1];
+            a2 += v * yz[3 * c2 + 2];
+        }
+        out[3 * r + 0] += c * a0;
+        out[3 * r + 1] += c * a1;
+        out[3 * r + 2] += c * a2;
+    }
+}
+
+/* y += Kc x for Kc = cK K + cD K0 in the shared basis: z' = pi_shared x, per stored pair
+ * (a <= b) out_a += Kc_ab z'_b and out_b += Kc_ab^T z'_a, then pi_shared^T out. */
+static void stiffness_multiply(const sem_object *o, double cK, double cD, const double *x, double *y)
+{
+    int ma = o->ma, n3 = 3 * ma;
+    size_t nz = (size_t)o->n_parts * n3, bs = (size_t)n3 * n3;
+    double *zs = calloc(2 * nz + 1, sizeof(double));
+    if (!zs) return; /* unreachable in practice; the product is then incomplete */
+    double *out = zs + nz;
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+    for (int i = 0; i < o->n_parts; ++i) {
+        int g = o->d->part_origin[i];
+        size_t n = sem_group_size(o, g);
+        const int *ctrl = o->group_ctrl + o->group_start[g];
+        for (int k = 0; k < ma; ++k) {
+            const double *row = o->pi_shared[i] + (size_t)k * n;
+            double s0 = 0, s1 = 0, s2 = 0;
+            for (size_t j = 0; j < n; ++j) {
+                const double *xc = x + 3 * (size_t)ctrl[j];
+                s0 += row[j] * xc[0];
+                s1 += row[j] * xc[1];
+                s2 += row[j] * xc[2];
+            }
+            zs[(size_t)i * n3 + 3 * k + 0] = s0;
+            zs[(size_t)i * n3 + 3 * k + 1] = s1;
+            zs[(size_t)i * n3 + 3 * k + 2] = s2;
+        }
+    }
+    /* Kz rows (k, d) = 3k + d, columns (d', k') = d' ma + k'; z' entries 3k + d */
+    for (int pr = 0; pr < o->n_pairs; ++pr) {
+        int a = o->pair_a[pr], b = o->pair_b[pr];
+        if (a > b || o->plist_start[pr + 1] == o->plist_start[pr]) continue;
+        const double *K = o->Kz + (size_t)pr * bs, *K0 = o->K0z + (size_t)pr * bs;
+        const double *za = zs + (size_t)a * n3, *zb = zs + (size_t)b * n3;
+        double *oa = out + (size_t)a * n3, *ob = out + (size_t)b * n3;
+        for (int r = 0; r < n3; ++r)
+            for (int d2 = 0; d2 < 3; ++d2)
+                for (int k2 = 0; k2 < ma; ++k2) {
+                    size_t at = (size_t)r * n3 + (size_t)(d2 * ma + k2);
+                    double v = cK * K[at] + (cD != 0 ? cD * K0[at] : 0);
+                    oa[r] += v * zb[3 * k2 + d2];
+                    if (a != b) ob[3 * k2 + d2] += v * za[r];
+                }
+    }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
+    for (int g = 0; g < o->n_groups; ++g)
+        for (int i = 0; i < o->n_parts; ++i) {
+            if (o->d->part_origin[i] != g) continue;
+            size_t n = sem_group_size(o, g);
+            const int *ctrl = o->group_ctrl + o->group_start[g];
+            const double *oi = out + (size_t)i * n3;
+            for (int k = 0; k < ma; ++k) {
+                const double *row = o->pi_shared[i] + (size_t)k * n;
+                for (size_t j = 0; j < n; ++j) {
+                    double *yc = y + 3 * (size_t)ctrl[j];
+                    yc[0] += row[j] * oi[3 * k + 0];
+                    yc[1] += row[j] * oi[3 * k + 1];
+                    yc[2] += row[j] * oi[3 * k + 2];
+                }
+            }
+        }
+    free(zs);
+}
+
+void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+                             const double *x, double *y)
+{
+    const sem_structured_ops *s = o->ops;
+    int r0 = s->r0;
+    memset(y, 0, 3 * (size_t)o->n_ctrl * sizeof(double));
+    double *yz = calloc(6 * (size_t)r0 + 3 * (size_t)s->n_rows + 1, sizeof(double));
+    if (!yz) return;
+    double *oz = yz + 3 * (size_t)r0, *res = oz + 3 * (size_t)r0;
+    apply_P(o, x, yz);
+    if (cM != 0) dense_multiply(o, s->Mz, cM, yz, oz);
+    if (cE != 0) {
+        double c = 2.0 * cE;
+        dense_multiply(o, s->Bz, c, yz, oz);
+        /* per sample: res_s = a_s (g_s P x - J_s x) */
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
+        for (int r = 0; r < s->n_rows; ++r) {
+            double a[3] = {0, 0, 0};
+            for (int e = s->g_start[r]; e < s->g_start[r + 1]; ++e)
+                for (int d = 0; d < 3; ++d) a[d] += s->g_val[e] * yz[3 * (size_t)s->g_idx[e] + d];
+            for (int e = s->j_start[r]; e < s->j_start[r + 1]; ++e)
+                for (int d = 0; d < 3; ++d) a[d] -= s->j_val[e] * x[3 * (size_t)s->j_col[e] + d];
+            for (int d = 0; d < 3; ++d) res[3 * (size_t)r + d] = c * s->area[r] * a[d];
+        }
+        /* M_eps x = sum_s (g_s P - J_s)^T res_s: the g part in coefficient space (then P^T
+         * below), the J part straight onto the control points; serial, in sample order */
+        for (int r = 0; r < s->n_rows; ++r) {
+            const double *rs = res + 3 * (size_t)r;
+            for (int e = s->g_start[r]; e < s->g_start[r + 1]; ++e)
+                for (int d = 0; d < 3; ++d) oz[3 * (size_t)s->g_idx[e] + d] += s->g_val[e] * rs[d];
+            for (int e = s->j_start[r]; e < s->j_start[r + 1]; ++e)
+                for (int d = 0; d < 3; ++d) y[3 * (size_t)s->j_col[e] + d] -= s->j_val[e] * rs[d];
+        }
+    }
+    apply_Pt(o, oz, y);
+    free(yz);
+    if (cK != 0 || cD != 0) stiffness_multiply(o, cK, cD, x, y);
+}
+
+void sem_structured_own_basis(const sem_object *o, int a, int b, const double *Kz_ab, int transpose,
+                              double *out)
+{
+    int m = o->m, ma = o->ma, n3 = 3 * ma, M3 = 3 * m;
+    double Ta[100], Tb[100];
+    const double *Xa = o->d->origin_X + 3 * (size_t)o->d->part_origin[a];
+    const double *Xb = o->d->origin_X + 3 * (size_t)o->d->part_origin[b];
+    double sa[3] = {o->ref_X[0] - Xa[0], o->ref_X[1] - Xa[1], o->ref_X[2] - Xa[2]};
+    double sb[3] = {o->ref_X[0] - Xb[0], o->ref_X[1] - Xb[1], o->ref_X[2] - Xb[2]};
+    sem_basis_shift(m, sa, Ta);
+    sem_basis_shift(m, sb, Tb);
+    /* R_i[p][k] = T_i[k][p + 1]: shared coefficient p (basis p + 1) from own coefficient k */
+    double Y[27 * 30]; /* Y[(3p + d)][(3l + d')] = sum_p' Kz[(3p+d)][(d' ma + p')] R_b[p'][l] */
+    for (int r = 0; r < n3; ++r)
+        for (int l = 0; l < m; ++l)
+            for (int d2 = 0; d2 < 3; ++d2) {
+                double v = 0;
+                for (int p2 = 0; p2 < ma; ++p2) v += Kz_ab[(size_t)r * n3 + d2 * ma + p2] * Tb[l * m + p2 + 1];
+                Y[r * M3 + 3 * l + d2] = v;
+            }
+    for (int k = 0; k < m; ++k)
+        for (int d = 0; d < 3; ++d)
+            for (int c = 0; c < M3; ++c) {
+                double v = 0;
+                for (int p = 0; p < ma; ++p) v += Ta[k * m + p + 1] * Y[(3 * p + d) * M3 + c];
+                if (transpose)
+                    out[(size_t)c * M3 + 3 * k + d] = v;
+                else
+                    out[(size_t)(3 * k + d) * M3 + c] = v;
+            }
+}
