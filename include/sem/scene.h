@@ -68,7 +68,17 @@ typedef struct sem_scene_object {
     sem_point_load *point_loads;
     int n_region_loads;
     sem_region_load *region_loads;
+    double friction;         /* Coulomb coefficient of its surface (sem/contact.h) */
 } sem_scene_object;
+
+/* A static collider ("colliders": [...]): a plane, or a model file (IGES, OBJ free-form or
+ * an OBJ triangle mesh) or a primitive, placed by its transform. */
+typedef struct sem_scene_collider {
+    int is_plane;
+    double point[3], normal[3];  /* the plane */
+    sem_scene_object shape;      /* otherwise: model_path or primitive, units and transform */
+    double friction;
+} sem_scene_collider;
 
 typedef struct sem_scene {
     char path[4096];         /* scene file ("" for the embedded default) */
@@ -81,6 +91,8 @@ typedef struct sem_scene {
     int write_iges, write_obj, write_mesh, write_usd;
     int write_glb;           /* output.glb: animation.glb */
     int mesh_resolution;
+    int n_colliders;
+    sem_scene_collider *colliders;
 } sem_scene;
 
 sem_status sem_scene_load(const char *path, sem_scene **out, sem_error *err);
@@ -101,6 +113,12 @@ sem_status sem_scene_object_model_units(const sem_scene *scene, int object, sem_
 /* The same without the units. */
 sem_status sem_scene_object_model(const sem_scene *scene, int object, sem_model **out,
                                   sem_error *err);
+/* The collider's definition for sem_world_add_collider: a plane, or the triangles of its
+ * model (tessellated) or OBJ triangle mesh, in metres and transformed. *vertices and
+ * *triangles (NULL for a plane) are the caller's to free. Errors name the key
+ * ("scene.json: colliders[0].model: terrain.obj:12: a face with 5 vertices ..."). */
+sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collider_def *out,
+                                  double **vertices, int **triangles, sem_error *err);
 /* Metres per unit of a unit name ("mm", "M", "inch", ...; case-insensitive), 0 if unknown.
  * canonical (may be NULL, 16 chars) receives the IGES name ("MM", "M", "IN", ...). */
 double sem_unit_to_meter(const char *name, char *canonical);

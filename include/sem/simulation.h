@@ -4,7 +4,8 @@
  * A world holds objects; each object is a NURBS model with its discretization
  * (sem/preprocess.h), materials, pinned control points and loads. The state of an object
  * is its control points q (3 per control point) and their velocities. A step advances
- * every object by dt with the chosen integrator; objects do not interact (no contact).
+ * every object by dt with the chosen integrator; objects touching each other or a static
+ * collider are kept apart by contact springs with friction (sem/contact.h).
  *
  * Usage: def = sem_default_world_def(); edit; world = sem_world_create(&def, &err);
  * obj = sem_default_object_def(); edit; sem_world_add_object(world, &obj, &err);
@@ -13,6 +14,7 @@
 #ifndef SEM_SIMULATION_H
 #define SEM_SIMULATION_H
 
+#include "sem/contact.h"
 #include "sem/material.h"
 #include "sem/model.h"
 #include "sem/preprocess.h"
@@ -65,6 +67,7 @@ typedef struct sem_world_def {
     sem_world_log_fn log;      /* may be NULL */
     void *log_user;
     sem_world_advanced advanced;
+    sem_contact_def contact;   /* contact settings (sem/contact.h); zero: the defaults */
 } sem_world_def;
 
 sem_world_def sem_default_world_def(void);
@@ -133,11 +136,14 @@ typedef struct sem_object_def {
     int n_point_loads;
     const sem_region_load *region_loads;
     int n_region_loads;
+    double friction;                     /* Coulomb coefficient of its surface
+                                            (sem_default_object_def: SEM_DEFAULT_FRICTION) */
 } sem_object_def;
 
 #define SEM_DEFAULT_BLEND 0.02
 
-/* Default material, blend SEM_DEFAULT_BLEND, everything else zero / NULL. */
+/* Default material, blend SEM_DEFAULT_BLEND, friction SEM_DEFAULT_FRICTION, everything else
+ * zero / NULL. */
 sem_object_def sem_default_object_def(void);
 
 typedef struct sem_world sem_world;
@@ -213,6 +219,11 @@ typedef struct sem_world_counters {
 
 sem_world_counters sem_world_get_counters(const sem_world *world);
 
+/* A static collider (sem/contact.h), copied. Returns its index or -1 (err set: a zero
+ * normal, a mesh with no triangle or a vertex index out of range, a negative friction). */
+int sem_world_add_collider(sem_world *world, const sem_collider_def *def, sem_error *err);
+/* Contact of the last step (contacts, smallest gap, time). */
+void sem_world_contact_stats(const sem_world *world, sem_contact_stats *stats);
 /* Memory a run of one object needs, in bytes, estimated from its discretization's sizes
  * (control points, parts, groups, quadrature points, samples, weights) in one cheap pass,
  * before anything large is allocated. src/physics/memory_estimate.c explains every term. */

@@ -119,13 +119,20 @@ class sem_world_advanced(Structure):
                 ("trace_newton", c_int), ("solve_together", c_int)]
 
 
+class sem_contact_def(Structure):
+    _c_header_ = "contact.h"
+    _fields_ = [("stiffness", c_double), ("thickness", c_double), ("self", c_int),
+                ("disabled", c_int), ("friction_velocity", c_double), ("resolution", c_int)]
+
+
 class sem_world_def(Structure):
     _c_header_ = "simulation.h"
     _fields_ = [("gravity", c_double * 3), ("integrator", c_int), ("dt", c_double),
                 ("rayleigh_mass", c_double), ("rayleigh_stiffness", c_double),
                 ("newton_tolerance", c_double), ("newton_max_iterations", c_int),
                 ("solver", c_int), ("threads", c_int), ("accept_unconverged", c_int), ("log", c_void_p),
-                ("log_user", c_void_p), ("advanced", sem_world_advanced)]
+                ("log_user", c_void_p), ("advanced", sem_world_advanced),
+                ("contact", sem_contact_def)]
 
 
 class sem_curve(Structure):
@@ -215,7 +222,7 @@ class sem_scene(Structure):
                 ("world", sem_world_def), ("frames", c_int), ("steps_per_frame", c_int),
                 ("output_dir", c_char * 4096), ("write_iges", c_int), ("write_obj", c_int),
                 ("write_mesh", c_int), ("write_usd", c_int), ("write_glb", c_int),
-                ("mesh_resolution", c_int)]
+                ("mesh_resolution", c_int), ("n_colliders", c_int), ("colliders", c_void_p)]
 
 
 sem_scene_log_fn = CFUNCTYPE(None, c_void_p, c_int, c_char_p)
@@ -230,7 +237,7 @@ class sem_scene_world_options(Structure):
 
 
 MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,
-                    sem_world_def,
+                    sem_contact_def, sem_world_def,
                     sem_curve, sem_surface, sem_trim_loop, sem_part, sem_model,
                     sem_preprocess_options, sem_preprocess_timings, sem_csr,
                     sem_discretization, sem_scene, sem_scene_world_options]

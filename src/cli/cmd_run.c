@@ -76,7 +76,8 @@ static cJSON *vec3(const double v[3])
 
 /* The numbers of one frame in summary.json, in this order in a state file. */
 enum { STAT_TIME, STAT_KINETIC, STAT_ELASTIC, STAT_GRAVITY, STAT_ERROR, STAT_COM,
-       STAT_LINEAR = STAT_COM + 3, STAT_ANGULAR = STAT_LINEAR + 3, STAT_COUNT = STAT_ANGULAR + 3 };
+       STAT_LINEAR = STAT_COM + 3, STAT_ANGULAR = STAT_LINEAR + 3, STAT_CONTACTS = STAT_ANGULAR + 3,
+       STAT_MIN_GAP, STAT_COUNT };
 
 typedef struct run_state {
     sem_scene *scene;
@@ -86,7 +87,7 @@ typedef struct run_state {
     sem_animation *anim;
     cJSON *frames;
     long long steps;
-    double step_sum, step_max, factor_sum;
+    double step_sum, step_max, factor_sum, contact_sum;
     int steps_timed;
     sem_run_info info;
     unsigned long long run_id;
@@ -123,6 +124,10 @@ static void frame_stats(run_state *r, double t, double *x)
         x[STAT_LINEAR + k] = tot.linear_momentum[k];
         x[STAT_ANGULAR + k] = tot.angular_momentum[k];
     }
+    sem_contact_stats cs;
+    sem_world_contact_stats(r->world, &cs);
+    x[STAT_CONTACTS] = cs.contacts;
+    x[STAT_MIN_GAP] = cs.min_gap;
 }
 
 static void add_frame_stats(run_state *r, const double *x)
@@ -136,6 +141,23 @@ static void add_frame_stats(run_state *r, const double *x)
     cJSON_AddItemToObject(f, "center_of_mass", vec3(x + STAT_COM));
     cJSON_AddItemToObject(f, "linear_momentum", vec3(x + STAT_LINEAR));
     cJSON_AddItemToObject(f, "angular_momentum", vec3(x + STAT_ANGULAR));
+    cJSON_AddNumberToObject(f, "contacts", x[STAT_CONTACTS]);
+    if (isfinite(x[STAT_MIN_GAP]))
+        cJSON_AddNumberToObject(f, "min_gap", x[STAT_MIN_GAP]);
+    else
+        cJSON_AddNullToObject(f, "min_gap"); /* no surface near any contact point */
+    /* per object (the world holds this frame's state, also when a run is resumed) */
+    cJSON *objs = cJSON_AddArrayToObject(f, "objects");
+    for (int i = 0; i < r->n; ++i) {
+        sem_object_stats st;
+        sem_world_object_stats(r->world, i, &st);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToObject(o, "center_of_mass", vec3(st.center_of_mass));
+        cJSON_AddItemToObject(o, "linear_momentum", vec3(st.linear_momentum));
+        cJSON_AddItemToObject(o, "angular_momentum", vec3(st.angular_momentum));
+        cJSON_AddNumberToObject(o, "kinetic_energy", st.kinetic_energy);
+        cJSON_AddItemToArray(objs, o);
+    }
     cJSON_AddItemToArray(r->frames, f);
 }
 
@@ -200,6 +222,7 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
     cJSON_AddNumberToObject(s, "mean_step_s", r->steps_timed ? r->step_sum / r->steps_timed : 0.0);
     cJSON_AddNumberToObject(s, "max_step_s", r->step_max);
     cJSON_AddNumberToObject(s, "mean_factor_s", r->steps_timed ? r->factor_sum / r->steps_timed : 0.0);
+    cJSON_AddNumberToObject(s, "contact_s", r->steps_timed ? r->contact_sum / r->steps_timed : 0.0);
     cJSON_AddNumberToObject(s, "preprocess_s", sem_scene_world_preprocess_seconds(r->sw));
     cJSON_AddBoolToObject(s, "preprocess_cached", sem_scene_world_all_cached(r->sw));
     /* the process's peak resident memory until now (getrusage), and what was estimated
@@ -581,6 +604,9 @@ int cmd_run(int argc, char **argv)
             r.steps_timed++;
             r.step_sum += dt;
             r.factor_sum += sem_world_last_factor_seconds(r.world);
+            sem_contact_stats cs;
+            sem_world_contact_stats(r.world, &cs);
+            r.contact_sum += cs.seconds;
             if (dt > r.step_max) r.step_max = dt;
             done_in_frame++;
             if (stop_signal) break;

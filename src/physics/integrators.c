@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "assembly.h"
+#include "contact/contact_world.h"
 #include "loads.h"
 #include "runaway.h"
 
@@ -58,6 +59,8 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
             for (size_t i = 0; i < no; ++i) rk[i] -= tk[i];
         }
     }
+    /* contact: springs and friction into the matrix and the right-hand side */
+    if (s->n_free > 0 && (st = sem_contact_linearized(w->contact, s, h, rhs, err)) != SEM_OK) goto done;
     if (s->n_free > 0) {
         st = sem_system_factorize(s, err);
         w->last_factor_s += sem_system_factor_seconds(s);
@@ -95,8 +98,12 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
     w->last_iterations = 0;
     double h = w->def.dt, t1 = w->time + h;
     for (int i = 0; i < w->n_systems; ++i) {
+        /* contact: friction lagged at q_n, coupling blocks between objects near each other
+         * (contact_world.h; may make the system again) */
+        sem_status st = sem_contact_begin_step(w->contact, &w->systems[i],
+                                               w->def.integrator == SEM_STATIC ? 0.0 : h, w->def.solver, err);
+        if (st != SEM_OK) return st;
         sem_system *s = w->systems[i];
-        sem_status st;
         switch (w->def.integrator) {
         case SEM_LINEARLY_IMPLICIT_EULER: st = step_linearly_implicit(w, s, err); break;
         case SEM_IMPLICIT_EULER: st = sem_newton_solve(w, s, h, t1, w->def.newton_max_iterations, err); break;
@@ -104,6 +111,7 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
         default: st = sem_newton_solve(w, s, 0.0, t1, w->def.newton_max_iterations, err); break;
         }
         if (st != SEM_OK) return st;
+        sem_contact_end_step(w->contact, s);
     }
     for (int k = 0; k < w->n_objects; ++k) {
         sem_status st = sem_runaway_check(w->objects[k], w->def.integrator == SEM_STATIC, t1, err);
@@ -120,8 +128,10 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
 {
     int max_iterations = w->def.newton_max_iterations < 200 ? 200 : w->def.newton_max_iterations;
     for (int i = 0; i < w->n_systems; ++i) {
-        sem_status st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);
+        sem_status st = sem_contact_begin_step(w->contact, &w->systems[i], 0.0, w->def.solver, err);
+        if (st == SEM_OK) st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);
         if (st != SEM_OK) return st;
+        sem_contact_end_step(w->contact, w->systems[i]);
     }
     for (int k = 0; k < w->n_objects; ++k) {
         sem_status st = sem_runaway_check(w->objects[k], 1, w->time, err);

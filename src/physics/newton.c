@@ -14,7 +14,9 @@
 #include <string.h>
 
 #include "assembly.h"
+#include "contact/contact_world.h"
 #include "loads.h"
+#include "point_terms.h"
 
 /* One solve: the world's settings, the system, and its vectors (n_dofs each). */
 typedef struct newton {
@@ -54,7 +56,10 @@ static double potential(const newton *nt, const double *q)
         }
         total = k == 0 ? E : total + E;
     }
-    return total;
+    /* contact: springs and friction (contact_world.h) */
+    sem_error e;
+    double Ec = sem_contact_potential(w->contact, s, q, h, NULL, &e);
+    return isnan(Ec) ? INFINITY : total + Ec;
 }
 
 /* The gradient g of E at q and, with the objects' K blocks, the Hessian's stiffness part:
@@ -84,6 +89,8 @@ static sem_status gradient(const newton *nt, const double *q, double *g, sem_err
             }
         }
     }
+    /* contact: its gradient, and its Hessian's point terms for factorize() */
+    if (isnan(sem_contact_potential(w->contact, s, q, h, g, err))) return err ? err->status : SEM_ERR_NOMEM;
     return SEM_OK;
 }
 
@@ -96,6 +103,10 @@ static void set_exact_hessian(sem_system *s, int on)
 static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, sem_error *err)
 {
     sem_system_fill(s, cM, 1.0, 1.0, cD);
+    /* contact: its Hessian (point_terms.h) */
+    const sem_point_terms *contact = sem_contact_terms(w->contact);
+    const double one = 1.0;
+    sem_system_set_point_terms(s, &contact, &one, 1);
     sem_status st = sem_system_factorize(s, err);
     w->last_factor_s += sem_system_factor_seconds(s);
     w->counters.factorizations++;

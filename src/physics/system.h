@@ -34,6 +34,13 @@
 #include "linear_solver.h"
 #include "object.h"
 
+/* A coupling block between two objects of a system: the control points of object a's
+ * group ga against those of object b's group gb (a < b, system indices). Contact between
+ * objects (point terms spanning two objects, point_terms.h) needs them in the pattern. */
+typedef struct sem_system_coupling {
+    int a, ga, b, gb;
+} sem_system_coupling;
+
 typedef struct sem_system {
     int n_objects;
     sem_object **objects;      /* not owned */
@@ -46,6 +53,11 @@ typedef struct sem_system {
     int structured;            /* the objects' own structured solvers (structured.h) instead */
     struct sem_structured_solver **ssolver; /* per object, NULL when it has nothing free */
     double factor_s;           /* seconds of the last factorization (structured) */
+    /* contact: coupling blocks, sorted (a, ga, b, gb); coupling_map[i] holds the position of
+     * entry (la, d, d', lb) at (9 la + 3 d + d') |Gb| + lb, or -1 (a pinned point) */
+    int n_couplings;
+    sem_system_coupling *couplings;
+    int **coupling_map;
 } sem_system;
 
 /* Where assembly writes an object's blocks while it forms them (sem_assemble_elastic). */
@@ -62,6 +74,11 @@ sem_status sem_object_free_dofs(sem_object *o, sem_error *err);
  * and solver. Sets every object's system. */
 sem_status sem_system_create(sem_object **objects, int n_objects, sem_solver_choice choice,
                              sem_system **out, sem_error *err);
+/* The same with coupling blocks between objects (copied; any order, duplicates allowed). */
+sem_status sem_system_create_coupled(sem_object **objects, int n_objects, const sem_system_coupling *couplings,
+                                     int n_couplings, sem_solver_choice choice, sem_system **out, sem_error *err);
+/* The coupling block (a, ga, b, gb) with a < b, or -1. */
+int sem_system_find_coupling(const sem_system *s, int a, int ga, int b, int gb);
 void sem_system_destroy(sem_system *s);
 
 /* The solver's values of object k's group pair g: c[0] M + c[1] 2 M_eps + c[2] K + c[3] K0

@@ -63,6 +63,40 @@ static void visit_entries(sem_system *s, int pass, int *count, int *rows, int *f
             }
         }
     }
+    /* contact: coupling blocks between objects (object a < b, so every entry is in the
+     * upper triangle) */
+    for (int i = 0; i < s->n_couplings; ++i) {
+        const sem_system_coupling *cp = &s->couplings[i];
+        const sem_object *oa = s->objects[cp->a], *ob = s->objects[cp->b];
+        size_t na = sem_group_size(oa, cp->ga), nb = sem_group_size(ob, cp->gb);
+        int *map = s->coupling_map[i];
+        for (size_t la = 0; la < na; ++la) {
+            int fa = oa->free_index[oa->group_ctrl[oa->group_start[cp->ga] + la]];
+            for (size_t lb = 0; lb < nb; ++lb) {
+                int fb = ob->free_index[ob->group_ctrl[ob->group_start[cp->gb] + lb]];
+                for (int dd = 0; dd < 9; ++dd) {
+                    size_t idx = (la * 9 + (size_t)dd) * nb + lb;
+                    if (fa < 0 || fb < 0) {
+                        if (pass == 1) map[idx] = -1;
+                        continue;
+                    }
+                    int r = 3 * (s->free_offset[cp->a] + fa) + dd / 3, c = 3 * (s->free_offset[cp->b] + fb) + dd % 3;
+                    if (pass == 0)
+                        count[c + 1]++;
+                    else {
+                        rows[fill[c]] = r;
+                        map[idx] = fill[c]++;
+                    }
+                }
+            }
+        }
+    }
+}
+
+static size_t coupling_entries(const sem_system *s, int i)
+{
+    const sem_system_coupling *cp = &s->couplings[i];
+    return 9 * sem_group_size(s->objects[cp->a], cp->ga) * sem_group_size(s->objects[cp->b], cp->gb);
 }
 
 /* CSC pattern of the free dofs (upper triangle), the maps and the solver. */
@@ -77,6 +111,13 @@ static sem_status build_pattern(sem_system *s, sem_solver_choice choice, sem_err
         const sem_object *o = s->objects[k];
         s->map[k] = malloc((9 * o->gpair_offset[o->n_gpairs] + 1) * sizeof(int));
         if (!s->map[k]) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
+            goto done;
+        }
+    }
+    for (int i = 0; i < s->n_couplings; ++i) {
+        s->coupling_map[i] = malloc((coupling_entries(s, i) + 1) * sizeof(int));
+        if (!s->coupling_map[i]) {
             st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the system pattern");
             goto done;
         }
@@ -121,12 +162,18 @@ static sem_status build_pattern(sem_system *s, sem_solver_choice choice, sem_err
         for (size_t e = 0; e < n; ++e)
             if (s->map[k][e] >= 0) s->map[k][e] = inv[s->map[k][e]];
     }
+    for (int i = 0; i < s->n_couplings; ++i)
+        for (size_t e = 0, n = coupling_entries(s, i); e < n; ++e)
+            if (s->coupling_map[i][e] >= 0) s->coupling_map[i][e] = inv[s->coupling_map[i][e]];
     st = sem_linear_solver_create(nf, count, sorted, choice, &s->solver, err);
     if (st == SEM_OK)
         for (int k = 0; k < s->n_objects; ++k) {
             const sem_object *o = s->objects[k];
             sem_linear_solver_remap(s->solver, s->map[k], 9 * o->gpair_offset[o->n_gpairs]);
         }
+    if (st == SEM_OK)
+        for (int i = 0; i < s->n_couplings; ++i)
+            sem_linear_solver_remap(s->solver, s->coupling_map[i], coupling_entries(s, i));
 done:
     free(sorted);
     free(perm);
@@ -137,8 +184,38 @@ done:
     return st;
 }
 
+static int compare_coupling(const void *x, const void *y)
+{
+    const sem_system_coupling *p = x, *q = y;
+    if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
+    if (p->ga != q->ga) return (p->ga > q->ga) - (p->ga < q->ga);
+    if (p->b != q->b) return (p->b > q->b) - (p->b < q->b);
+    return (p->gb > q->gb) - (p->gb < q->gb);
+}
+
+int sem_system_find_coupling(const sem_system *s, int a, int ga, int b, int gb)
+{
+    const sem_system_coupling key = {a, ga, b, gb};
+    int lo = 0, hi = s->n_couplings - 1;
+    while (lo <= hi) {
+        int mid = (lo + hi) / 2, c = compare_coupling(&s->couplings[mid], &key);
+        if (c == 0) return mid;
+        if (c < 0)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
 sem_status sem_system_create(sem_object **objects, int n_objects, sem_solver_choice choice,
                              sem_system **out, sem_error *err)
+{
+    return sem_system_create_coupled(objects, n_objects, NULL, 0, choice, out, err);
+}
+
+sem_status sem_system_create_coupled(sem_object **objects, int n_objects, const sem_system_coupling *couplings,
+                                     int n_couplings, sem_solver_choice choice, sem_system **out, sem_error *err)
 {
     *out = NULL;
     sem_system *s = calloc(1, sizeof *s);
@@ -161,6 +238,27 @@ sem_status sem_system_create(sem_object **objects, int n_objects, sem_solver_cho
     }
     s->n_free = s->free_offset[n_objects];
     s->n_dofs = s->dof_offset[n_objects];
+    /* contact's coupling blocks: sorted, without duplicates, a < b */
+    if (n_couplings > 0) {
+        s->couplings = malloc((size_t)n_couplings * sizeof *s->couplings);
+        s->coupling_map = calloc((size_t)n_couplings, sizeof *s->coupling_map);
+        if (!s->couplings || !s->coupling_map) {
+            sem_system_destroy(s);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        for (int i = 0; i < n_couplings; ++i) {
+            sem_system_coupling cp = couplings[i];
+            if (cp.a > cp.b) cp = (sem_system_coupling){cp.b, cp.gb, cp.a, cp.ga};
+            if (cp.a == cp.b || cp.a < 0 || cp.b >= n_objects) continue;
+            s->couplings[s->n_couplings++] = cp;
+        }
+        qsort(s->couplings, (size_t)s->n_couplings, sizeof *s->couplings, compare_coupling);
+        int kept = 0;
+        for (int i = 0; i < s->n_couplings; ++i)
+            if (kept == 0 || compare_coupling(&s->couplings[kept - 1], &s->couplings[i]) != 0)
+                s->couplings[kept++] = s->couplings[i];
+        s->n_couplings = kept;
+    }
     s->structured = n_objects > 0 && objects[0]->structured;
     if (s->structured) {
         s->ssolver = calloc(n, sizeof *s->ssolver);
@@ -194,6 +292,10 @@ void sem_system_destroy(sem_system *s)
     if (s->map)
         for (int k = 0; k < s->n_objects; ++k) free(s->map[k]);
     free(s->map);
+    if (s->coupling_map)
+        for (int i = 0; i < s->n_couplings; ++i) free(s->coupling_map[i]);
+    free(s->coupling_map);
+    free(s->couplings);
     if (s->ssolver)
         for (int k = 0; k < s->n_objects; ++k) sem_structured_solver_destroy(s->ssolver[k]);
     free(s->ssolver);

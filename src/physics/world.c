@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "assembly.h"
+#include "contact/contact_world.h"
 #include "input_scales.h"
 #include "runaway.h"
 #include "loads.h"
@@ -47,6 +48,7 @@ sem_object_def sem_default_object_def(void)
     memset(&d, 0, sizeof d);
     d.material = sem_default_material();
     d.blend = SEM_DEFAULT_BLEND;
+    d.friction = SEM_DEFAULT_FRICTION;
     return d;
 }
 
@@ -73,6 +75,10 @@ sem_world *sem_world_create(const sem_world_def *def, sem_error *err)
     w->def = *def;
     if (w->def.newton_tolerance <= 0) w->def.newton_tolerance = 1e-8;
     if (w->def.newton_max_iterations <= 0) w->def.newton_max_iterations = 50;
+    if (sem_contact_create(&def->contact, &w->contact, err) != SEM_OK) {
+        free(w);
+        return NULL;
+    }
     return w;
 }
 
@@ -145,6 +151,7 @@ void sem_world_destroy(sem_world *w)
     if (!w) return;
     for (int i = 0; i < w->n_systems; ++i) sem_system_destroy(w->systems[i]);
     for (int i = 0; i < w->n_objects; ++i) object_destroy(w->objects[i]);
+    sem_contact_destroy(w->contact);
     free(w->objects);
     free(w->systems);
     free(w);
@@ -171,6 +178,10 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
 {
     if (!def->model || !def->disc) {
         sem_error_set(err, SEM_ERR_INVALID, "object needs a model and its discretization");
+        return -1;
+    }
+    if (!(def->friction >= 0) || !isfinite(def->friction)) {
+        sem_error_set(err, SEM_ERR_INVALID, "object friction must be >= 0 (got %g)", def->friction);
         return -1;
     }
     const sem_discretization *d = def->disc;
@@ -321,22 +332,43 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         }
         w->cap = nc;
     }
-    /* its system: of its own, or (solve_together) the one system of every object, built
-     * again with the new one */
+    /* contact: its collision mesh */
+    if ((st = sem_contact_add_object(w->contact, o, err)) != SEM_OK) goto fail;
+    /* its system: of its own, or (solve_together, or contact between objects: objects that
+     * may touch are solved together) the one system of every object, built again with the
+     * new one */
     w->objects[w->n_objects] = o;
-    if (w->def.advanced.solve_together && w->n_systems == 1) {
-        if ((st = sem_system_create(w->objects, w->n_objects + 1, w->def.solver, &sys, err)) != SEM_OK)
+    if ((w->def.advanced.solve_together || sem_contact_between_objects(w->contact)) && w->n_systems == 1) {
+        if ((st = sem_system_create(w->objects, w->n_objects + 1, w->def.solver, &sys, err)) != SEM_OK) {
+            sem_contact_remove_last_object(w->contact);
             goto fail;
+        }
         sem_system_destroy(w->systems[0]);
         w->systems[0] = sys;
     } else {
-        if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) goto fail;
+        if ((st = sem_system_create(&o, 1, w->def.solver, &sys, err)) != SEM_OK) {
+            sem_contact_remove_last_object(w->contact);
+            goto fail;
+        }
         w->systems[w->n_systems++] = sys;
     }
     return w->n_objects++;
 fail:
     object_destroy(o);
     return -1;
+}
+
+int sem_world_add_collider(sem_world *w, const sem_collider_def *def, sem_error *err)
+{
+    if (sem_contact_add_collider(w->contact, def, err) != SEM_OK) return -1;
+    sem_contact_stats st;
+    sem_contact_get_stats(w->contact, &st);
+    return st.colliders - 1;
+}
+
+void sem_world_contact_stats(const sem_world *w, sem_contact_stats *stats)
+{
+    sem_contact_get_stats(w->contact, stats);
 }
 
 /* ---------------------------------------------------------------------------------- */

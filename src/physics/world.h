@@ -21,6 +21,7 @@ struct sem_world {
     double last_step_s, last_factor_s;
     int last_iterations;
     sem_world_counters counters;
+    struct sem_contact *contact; /* colliders, collision meshes, friction (contact_world.h) */
 };
 
 #endif

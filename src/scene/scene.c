@@ -15,9 +15,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
+#include "io/mesh_obj_read.h"
 #include "io/read_file.h"
 #include "sem/limits.h"
+#include "sem/tessellate.h"
 #include "sem/primitives.h"
 
 typedef struct ctx {
@@ -438,21 +441,14 @@ static sem_status parse_selection(ctx *c, const cJSON *pin, const char *w, int *
     return SEM_OK;
 }
 
-static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *base_dir,
-                               sem_scene_object *obj)
+/* The shape of an object or a collider: "model" (with "units") or "primitive", and
+ * "transform" (where: "objects[0]", "colliders[1]"). */
+static sem_status parse_shape(ctx *c, const cJSON *o, const char *where, const char *base_dir,
+                              sem_scene_object *obj)
 {
-    static const char *const keys[] = {"model", "primitive", "transform", "material",
-                                       "part_materials", "sem", "pin", "prescribe",
-                                       "initial_velocity", "initial_angular_velocity",
-                                       "point_loads", "region_loads", "gamma", "units", NULL};
-    char where[64], w[256];
-    snprintf(where, sizeof where, "objects[%d]", index);
-    sem_status st = check_keys(c, o, where, keys);
-    if (st != SEM_OK) return st;
+    char w[256];
+    sem_status st;
     mat_identity(obj->transform);
-    obj->material = sem_default_material();
-    obj->sem = sem_default_preprocess_options();
-    obj->blend = SEM_DEFAULT_BLEND;
     const cJSON *model = cJSON_GetObjectItemCaseSensitive(o, "model");
     const cJSON *prim = cJSON_GetObjectItemCaseSensitive(o, "primitive");
     const cJSON *units = cJSON_GetObjectItemCaseSensitive(o, "units");
@@ -549,6 +545,30 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     if (t) {
         snprintf(w, sizeof w, "%s.transform", where);
         if ((st = parse_transform(c, t, w, obj->transform)) != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
+static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *base_dir,
+                               sem_scene_object *obj)
+{
+    static const char *const keys[] = {"model", "primitive", "transform", "material",
+                                       "part_materials", "sem", "pin", "prescribe",
+                                       "initial_velocity", "initial_angular_velocity",
+                                       "point_loads", "region_loads", "gamma", "units", "friction", NULL};
+    char where[64], w[256];
+    snprintf(where, sizeof where, "objects[%d]", index);
+    sem_status st = check_keys(c, o, where, keys);
+    if (st != SEM_OK) return st;
+    obj->material = sem_default_material();
+    obj->sem = sem_default_preprocess_options();
+    obj->blend = SEM_DEFAULT_BLEND;
+    if ((st = parse_shape(c, o, where, base_dir, obj)) != SEM_OK) return st;
+    obj->friction = SEM_DEFAULT_FRICTION;
+    if ((st = get_number(c, o, "friction", where, &obj->friction)) != SEM_OK) return st;
+    if (!(obj->friction >= 0)) {
+        snprintf(w, sizeof w, "%s.friction", where);
+        return fail(c, w, "must be >= 0 (got %g)", obj->friction);
     }
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "material");
     if (m) {
@@ -715,6 +735,98 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     return SEM_OK;
 }
 
+/* "contact": the world's contact settings (sem/contact.h). */
+static sem_status parse_contact(ctx *c, const cJSON *root, sem_contact_def *def)
+{
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "contact");
+    if (!o) return SEM_OK;
+    static const char *const keys[] = {"enabled", "stiffness", "thickness", "self", "friction_velocity",
+                                       "resolution", NULL};
+    const char *w = "contact";
+    sem_status st = check_keys(c, o, w, keys);
+    if (st != SEM_OK) return st;
+    int enabled = 1;
+    if ((st = get_bool(c, o, "enabled", w, &enabled)) != SEM_OK) return st;
+    def->disabled = !enabled;
+    if ((st = get_bool(c, o, "self", w, &def->self)) != SEM_OK) return st;
+    if (def->self) return fail(c, "contact.self", "self-contact is not implemented yet (use false)");
+    static const char *const positive[] = {"stiffness", "thickness", "friction_velocity", NULL};
+    double *values[] = {&def->stiffness, &def->thickness, &def->friction_velocity};
+    for (int k = 0; positive[k]; ++k) {
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, positive[k]);
+        if (!v || cJSON_IsNull(v)) continue; /* null: the default */
+        if ((st = get_number(c, o, positive[k], w, values[k])) != SEM_OK) return st;
+        if (!(*values[k] > 0)) {
+            char wk[64];
+            snprintf(wk, sizeof wk, "contact.%s", positive[k]);
+            return fail(c, wk, "must be positive or null (got %g)", *values[k]);
+        }
+    }
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(o, "resolution");
+    if (r && !cJSON_IsNull(r)) {
+        if ((st = get_int(c, o, "resolution", w, &def->resolution)) != SEM_OK) return st;
+        if (def->resolution < 1 || def->resolution > 64)
+            return fail(c, "contact.resolution", "must be in 1..64 or null (got %d)", def->resolution);
+    }
+    return SEM_OK;
+}
+
+/* colliders[i]: a plane, a model file or a primitive, with a friction coefficient. */
+static sem_status parse_collider(ctx *c, const cJSON *o, int index, const char *base_dir,
+                                 sem_scene_collider *col)
+{
+    static const char *const keys[] = {"plane", "model", "primitive", "units", "transform", "friction", NULL};
+    char where[64], w[256];
+    snprintf(where, sizeof where, "colliders[%d]", index);
+    sem_status st = check_keys(c, o, where, keys);
+    if (st != SEM_OK) return st;
+    col->friction = SEM_DEFAULT_FRICTION;
+    if ((st = get_number(c, o, "friction", where, &col->friction)) != SEM_OK) return st;
+    if (!(col->friction >= 0)) {
+        snprintf(w, sizeof w, "%s.friction", where);
+        return fail(c, w, "must be >= 0 (got %g)", col->friction);
+    }
+    const cJSON *plane = cJSON_GetObjectItemCaseSensitive(o, "plane");
+    int shapes = !!plane + !!cJSON_GetObjectItemCaseSensitive(o, "model") +
+                 !!cJSON_GetObjectItemCaseSensitive(o, "primitive");
+    if (shapes != 1) return fail(c, where, "needs exactly one of \"plane\", \"model\" or \"primitive\"");
+    if (plane) {
+        static const char *const pkeys[] = {"point", "normal", NULL};
+        snprintf(w, sizeof w, "%s.plane", where);
+        if ((st = check_keys(c, plane, w, pkeys)) != SEM_OK) return st;
+        if (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "units"))
+            return fail(c, where, "a plane takes no \"transform\" or \"units\" (give its point and normal)");
+        col->is_plane = 1;
+        col->normal[2] = 1;
+        if ((st = get_vec(c, plane, "point", w, 3, col->point)) != SEM_OK) return st;
+        if ((st = get_vec(c, plane, "normal", w, 3, col->normal)) != SEM_OK) return st;
+        double n2 = col->normal[0] * col->normal[0] + col->normal[1] * col->normal[1] + col->normal[2] * col->normal[2];
+        if (!(n2 > 0) || !isfinite(n2)) {
+            snprintf(w, sizeof w, "%s.plane.normal", where);
+            return fail(c, w, "must be non-zero");
+        }
+        return SEM_OK;
+    }
+    return parse_shape(c, o, where, base_dir, &col->shape);
+}
+
+static sem_status parse_colliders(ctx *c, const cJSON *root, const char *base_dir, sem_scene *s)
+{
+    const cJSON *cols = cJSON_GetObjectItemCaseSensitive(root, "colliders");
+    if (!cols) return SEM_OK;
+    if (!cJSON_IsArray(cols)) return fail(c, "colliders", "must be an array of colliders");
+    int n = cJSON_GetArraySize(cols);
+    s->colliders = calloc((size_t)n + 1, sizeof *s->colliders);
+    if (!s->colliders) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
+    int k = 0;
+    for (const cJSON *it = cols->child; it; it = it->next, ++k) {
+        s->n_colliders = k + 1;
+        sem_status st = parse_collider(c, it, k, base_dir, &s->colliders[k]);
+        if (st != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
 static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
 {
     sem_status st;
@@ -820,6 +932,7 @@ void sem_scene_destroy(sem_scene *s)
     if (!s) return;
     for (int i = 0; i < s->n_objects; ++i) object_free(&s->objects[i]);
     free(s->objects);
+    free(s->colliders);
     free(s);
 }
 
@@ -921,9 +1034,12 @@ sem_status sem_scene_parse(const char *json, const char *name, const char *base_
     s->write_glb = 1;
     s->mesh_resolution = 6;
     static const char *const keys[] = {"objects", "gravity", "integrator", "frames",
-                                       "steps_per_frame", "output", "threads", "description", NULL};
+                                       "steps_per_frame", "output", "threads", "description",
+                                       "colliders", "contact", NULL};
     sem_status st = check_keys(&c, root, "scene", keys);
     if (st == SEM_OK) st = parse_world(&c, root, s);
+    if (st == SEM_OK) st = parse_contact(&c, root, &s->world.contact);
+    if (st == SEM_OK) st = parse_colliders(&c, root, base_dir, s);
     const cJSON *objs = cJSON_GetObjectItemCaseSensitive(root, "objects");
     if (st == SEM_OK && (!cJSON_IsArray(objs) || cJSON_GetArraySize(objs) == 0))
         st = fail(&c, "objects", "must be a non-empty array of objects");
@@ -1049,11 +1165,11 @@ sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model *
     return sem_scene_object_model_units(scene, index, out, NULL, NULL, err);
 }
 
-sem_status sem_scene_object_model_units(const sem_scene *scene, int index, sem_model **out,
-                                        double *file_unit_to_meter, char *file_units,
-                                        sem_error *err)
+/* The model of an object's or a collider's shape (where: "objects[0]", "colliders[1]"), in
+ * metres and transformed. */
+static sem_status shape_model(const sem_scene *scene, const sem_scene_object *o, const char *where,
+                              sem_model **out, double *file_unit_to_meter, char *file_units, sem_error *err)
 {
-    const sem_scene_object *o = &scene->objects[index];
     *out = NULL;
     sem_status st;
     sem_model *m = NULL;
@@ -1064,8 +1180,7 @@ sem_status sem_scene_object_model_units(const sem_scene *scene, int index, sem_m
             if (err) {
                 char msg[sizeof err->message];
                 snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: objects[%d].model: %s", scene->path[0] ? scene->path : "scene",
-                              index, msg);
+                sem_error_set(err, st, "%s: %s.model: %s", scene->path[0] ? scene->path : "scene", where, msg);
             }
             return st;
         }
@@ -1122,6 +1237,102 @@ sem_status sem_scene_object_model_units(const sem_scene *scene, int index, sem_m
     if (file_units) snprintf(file_units, 16, "%s", label);
     apply_transform(m, o->transform);
     *out = m;
+    return SEM_OK;
+}
+
+sem_status sem_scene_object_model_units(const sem_scene *scene, int index, sem_model **out,
+                                        double *file_unit_to_meter, char *file_units,
+                                        sem_error *err)
+{
+    char where[64];
+    snprintf(where, sizeof where, "objects[%d]", index);
+    return shape_model(scene, &scene->objects[index], where, out, file_unit_to_meter, file_units, err);
+}
+
+/* Cells per knot span of a collider model's tessellation: flat or gently curved obstacles
+ * and terrains need few. */
+#define COLLIDER_RESOLUTION 8
+
+sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collider_def *out,
+                                  double **vertices, int **triangles, sem_error *err)
+{
+    const sem_scene_collider *col = &scene->colliders[index];
+    const char *name = scene->path[0] ? scene->path : "scene";
+    *vertices = NULL;
+    *triangles = NULL;
+    *out = sem_default_collider_def();
+    out->friction = col->friction;
+    if (col->is_plane) {
+        out->type = SEM_COLLIDER_PLANE;
+        memcpy(out->point, col->point, sizeof out->point);
+        memcpy(out->normal, col->normal, sizeof out->normal);
+        return SEM_OK;
+    }
+    out->type = SEM_COLLIDER_MESH;
+    char where[64];
+    snprintf(where, sizeof where, "colliders[%d]", index);
+    const sem_scene_object *o = &col->shape;
+    size_t len = strlen(o->model_path);
+    int freeform = 1;
+    sem_triangle_soup soup;
+    memset(&soup, 0, sizeof soup);
+    sem_status st;
+    if (len > 4 && !strcasecmp(o->model_path + len - 4, ".obj")) {
+        /* a plain triangle mesh, unless the file holds free-form surfaces */
+        st = sem_obj_triangles_read(o->model_path, &soup, &freeform, err);
+        if (st != SEM_OK) {
+            if (err) {
+                char msg[sizeof err->message];
+                snprintf(msg, sizeof msg, "%s", err->message);
+                sem_error_set(err, st, "%s: %s.model: %s", name, where, msg);
+            }
+            return st;
+        }
+    }
+    if (!freeform) {
+        double f = 1.0;
+        if (o->units[0] && strcmp(o->units, "as_metres") != 0) f = sem_unit_to_meter(o->units, NULL);
+        for (int v = 0; v < soup.n_vertices; ++v) {
+            double *x = soup.vertices + 3 * (size_t)v, y[3];
+            for (int r = 0; r < 3; ++r)
+                y[r] = o->transform[4 * r] * f * x[0] + o->transform[4 * r + 1] * f * x[1] +
+                       o->transform[4 * r + 2] * f * x[2] + o->transform[4 * r + 3];
+            memcpy(x, y, sizeof y);
+        }
+    } else {
+        sem_model *m = NULL;
+        if ((st = shape_model(scene, o, where, &m, NULL, NULL, err)) != SEM_OK) return st;
+        sem_mesh mesh;
+        memset(&mesh, 0, sizeof mesh);
+        st = sem_mesh_from_model(m, COLLIDER_RESOLUTION, &mesh, err);
+        sem_model_destroy(m);
+        if (st != SEM_OK) {
+            if (err) {
+                char msg[sizeof err->message];
+                snprintf(msg, sizeof msg, "%s", err->message);
+                sem_error_set(err, st, "%s: %s: %s", name, where, msg);
+            }
+            return st;
+        }
+        soup.n_vertices = mesh.n_vertices;
+        soup.n_triangles = mesh.n_triangles;
+        soup.vertices = mesh.positions;
+        soup.triangles = mesh.triangles;
+        mesh.positions = NULL;
+        mesh.triangles = NULL;
+        sem_mesh_free(&mesh);
+        if (soup.n_triangles == 0) {
+            sem_triangle_soup_free(&soup);
+            return sem_error_set(err, SEM_ERR_INVALID, "%s: %s: the model has no surface to collide with", name,
+                                 where);
+        }
+    }
+    out->vertices = soup.vertices;
+    out->n_vertices = soup.n_vertices;
+    out->triangles = soup.triangles;
+    out->n_triangles = soup.n_triangles;
+    *vertices = soup.vertices;
+    *triangles = soup.triangles;
     return SEM_OK;
 }
 

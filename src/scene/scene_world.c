@@ -76,6 +76,16 @@ static sem_status prefix_error(sem_error *err, sem_status st, const char *name, 
     return sem_error_set(err, st, "%s: objects[%d]%s%s", name, i, sep, msg);
 }
 
+/* The scene's world settings. Contact: the structured solver takes no contact terms yet
+ * (point_terms.h), so a scene where contact can happen (colliders, or two objects or more)
+ * keeps the q-space solvers, as objects solved together do. */
+static sem_world_def scene_world_def(const sem_scene *scene)
+{
+    sem_world_def d = scene->world;
+    if (!d.contact.disabled && (scene->n_colliders > 0 || scene->n_objects >= 2)) d.advanced.solve_together = 1;
+    return d;
+}
+
 /* Preprocesses, or loads from the cache; *cached tells which. */
 static sem_status preprocess_cached(const sem_model *model, const sem_preprocess_options *opt,
                                     const sem_scene_world_options *o, sem_discretization **out,
@@ -191,7 +201,8 @@ static sem_status prepare_object(sem_scene_world *sw, int i, const sem_scene_wor
     int cached = 0;
     /* the q-space operators only for the solvers that use them */
     sem_preprocess_options popt = so->sem;
-    popt.q_space_operators = !sem_world_def_structured(&scene->world, sem_model_control_points(model),
+    sem_world_def wdef = scene_world_def(scene);
+    popt.q_space_operators = !sem_world_def_structured(&wdef, sem_model_control_points(model),
                                                        model->n_parts, popt.order == 1 ? 4 : 10);
     st = preprocess_cached(model, &popt, o, &sw->discs[i], &cached, err);
     if (st != SEM_OK) return prefix_error(err, st, name, i, ": ");
@@ -276,9 +287,30 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.n_point_loads = so->n_point_loads;
     od.region_loads = so->region_loads;
     od.n_region_loads = so->n_region_loads;
+    od.friction = so->friction;
     int id = sem_world_add_object(sw->world, &od, err);
     if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
     return o->skip_modes ? SEM_OK : check_modes(sw, i, id, o, err);
+}
+
+/* The scene's collider i into the world. */
+static sem_status add_collider(sem_scene_world *sw, int i, sem_error *err)
+{
+    sem_collider_def def;
+    double *vertices = NULL;
+    int *triangles = NULL;
+    sem_status st = sem_scene_collider_def(sw->scene, i, &def, &vertices, &triangles, err);
+    if (st == SEM_OK && sem_world_add_collider(sw->world, &def, err) < 0) {
+        st = err ? err->status : SEM_ERR_INVALID;
+        if (err) {
+            char msg[sizeof err->message];
+            snprintf(msg, sizeof msg, "%s", err->message);
+            sem_error_set(err, st, "%s: colliders[%d]: %s", sw->scene->path[0] ? sw->scene->path : "scene", i, msg);
+        }
+    }
+    free(vertices);
+    free(triangles);
+    return st;
 }
 
 sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_options *options,
@@ -310,7 +342,8 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    sw->world = sem_world_create(&scene->world, err);
+    sem_world_def wdef = scene_world_def(scene);
+    sw->world = sem_world_create(&wdef, err);
     if (!sw->world) {
         st = err ? err->status : SEM_ERR_INVALID;
         if (err && scene->path[0] && !strstr(err->message, scene->path)) {
@@ -320,6 +353,9 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
         }
         goto fail;
     }
+    /* static colliders first: a bad one fails before any preprocessing */
+    for (int i = 0; i < scene->n_colliders; ++i)
+        if ((st = add_collider(sw, i, err)) != SEM_OK) goto fail;
     sw->all_cached = 1;
     double t0 = omp_get_wtime();
     for (int i = 0; i < sw->n; ++i)

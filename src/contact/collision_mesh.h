@@ -1,0 +1,42 @@
+/*
+ * collision_mesh.h - the surface points and triangles of an object that contact sees
+ * (internal to src/contact/).
+ *
+ * The render tessellation of the object's NURBS parts (sem/tessellate.h), with each vertex
+ * kept as its row of the render map x = J q (the paper's Sec. 7-8): the rational basis
+ * values phi_k(u, v) of its part's control points, evaluated once. Positions for any q are
+ * then a sparse product, and a force f on a point reaches the control points as J^T f
+ * (phi_k f each), as point loads do. Each point carries its share of the rest surface area
+ * (a third of its triangles'), which scales its contact spring. Vertices no kept triangle
+ * uses (trimmed away) are dropped.
+ */
+#ifndef SEM_CONTACT_COLLISION_MESH_H
+#define SEM_CONTACT_COLLISION_MESH_H
+
+#include "broad_phase.h"
+#include "sem/model.h"
+
+typedef struct sem_collision_mesh {
+    int n_points;
+    int *row_start;        /* n_points + 1: J's rows (CSR) */
+    int *row_ctrl;         /* control point of the object (model order) */
+    double *row_w;         /* phi */
+    double *area;          /* rest area share per point */
+    int n_triangles;
+    int *triangles;        /* 3 point indices per triangle */
+    double *x;             /* current positions (sem_collision_mesh_update) */
+    double *pseudo_normal; /* current area-weighted vertex normals (outward) */
+    double length;         /* bounding-box diagonal at rest */
+    int resolution;        /* tessellation cells per knot span used */
+    sem_bvh bvh;           /* over the triangles at the last update */
+} sem_collision_mesh;
+
+/* The mesh of a model (rest control points q0 = the model's). resolution <= 0: the
+ * automatic choice of sem_contact_def.resolution. */
+sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_collision_mesh *out,
+                                    sem_error *err);
+void sem_collision_mesh_free(sem_collision_mesh *m);
+/* x = J q for every point, vertex normals, and (refit_tree) the tree's boxes. */
+void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int refit_tree);
+
+#endif

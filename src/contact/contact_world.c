@@ -1,0 +1,839 @@
+/*
+ * contact_world.c - colliders, detection, and the contact potential of a world's system
+ * (see contact_world.h; the springs in penalty.c, friction in friction.c).
+ */
+#include "contact_world.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "collision_mesh.h"
+#include "friction.h"
+#include "penalty.h"
+
+/* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
+#define KAPPA 1000.0
+#define DEFAULT_THICKNESS 1e-3     /* x L */
+#define SEARCH_DEPTH 0.05          /* x L: how deep a point may be and still be pushed out */
+#define DEFAULT_FRICTION_VELOCITY 1e-3
+#define MAX_WEIGHTS 192            /* a point's row plus a triangle's three rows */
+
+typedef struct collider {
+    sem_collider_type type;
+    double point[3], normal[3];
+    double friction;
+    int n_vertices, n_triangles;
+    double *vertices;
+    int *triangles;
+    double *face_normal;   /* unit, per triangle */
+    double *edge_normal;   /* per triangle edge (3 per triangle): sum of the faces' normals */
+    double *vertex_normal; /* angle-weighted pseudonormal (Baerentzen and Aanaes 2005) */
+    sem_bvh bvh;
+} collider;
+
+typedef struct contact_object {
+    const sem_object *object;
+    int built;               /* mesh and the numbers below (mesh_for) */
+    sem_collision_mesh mesh;
+    double youngs, friction, length, thickness;
+} contact_object;
+
+/* An active contact: point `point` of system object k against a collider or a triangle of
+ * system object `other`. */
+typedef struct contact_rec {
+    int k, point, other, collider, triangle;
+    double bary[3];
+    double d, n[3];          /* signed distance and its gradient */
+    double stiffness, thickness, mu;
+} contact_rec;
+
+/* A friction contact fixed at the start of a step (friction.h). */
+typedef struct friction_rec {
+    int first, count;        /* weights */
+    double T[6], X0[3], mu_lambda;
+} friction_rec;
+
+struct sem_contact {
+    sem_contact_def def;
+    int n_colliders, cap_colliders;
+    collider *colliders;
+    int n_objects, cap_objects;
+    contact_object *objects;
+    /* per evaluation */
+    int n_recs, cap_recs;
+    contact_rec *recs;
+    contact_rec *slots;      /* detection scratch: per point of an object, its contacts */
+    int *slot_count;
+    size_t cap_slots;
+    int cap_count;
+    int *sys_to_contact;     /* system object -> contact object */
+    int n_sys;
+    double min_gap;
+    sem_point_terms terms;   /* Hessian of the last sem_contact_potential with a gradient */
+    sem_point_terms friction_terms;
+    /* friction of the current step */
+    int n_friction, cap_friction;
+    friction_rec *friction;
+    int n_fweights, cap_fweights;
+    sem_point_weight *fweights;
+    double friction_eps;     /* eps_v h of the step; 0: no friction */
+    int n_couplings, cap_couplings;
+    sem_system_coupling *couplings; /* the blocks contact between objects needs */
+    long rebuilds;           /* systems made again for new coupling blocks */
+    sem_contact_stats stats;
+};
+
+/* ---------------------------------------------------------------------------------- */
+/* life cycle                                                                          */
+
+sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem_error *err)
+{
+    *out = NULL;
+    if (!isfinite(def->stiffness) || !isfinite(def->thickness) || !isfinite(def->friction_velocity))
+        return sem_error_set(err, SEM_ERR_INVALID, "contact settings must be finite");
+    if (def->self) return sem_error_set(err, SEM_ERR_INVALID, "contact: self-contact is not implemented yet");
+    if (def->resolution > 64)
+        return sem_error_set(err, SEM_ERR_INVALID, "contact resolution must be at most 64 (got %d)", def->resolution);
+    sem_contact *c = calloc(1, sizeof *c);
+    if (!c) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    c->def = *def;
+    if (!(c->def.friction_velocity > 0)) c->def.friction_velocity = DEFAULT_FRICTION_VELOCITY;
+    c->stats.min_gap = INFINITY;
+    sem_point_terms_init(&c->terms);
+    sem_point_terms_init(&c->friction_terms);
+    *out = c;
+    return SEM_OK;
+}
+
+static void collider_free(collider *k)
+{
+    free(k->vertices);
+    free(k->triangles);
+    free(k->face_normal);
+    free(k->edge_normal);
+    free(k->vertex_normal);
+    sem_bvh_free(&k->bvh);
+}
+
+void sem_contact_destroy(sem_contact *c)
+{
+    if (!c) return;
+    for (int i = 0; i < c->n_colliders; ++i) collider_free(&c->colliders[i]);
+    for (int i = 0; i < c->n_objects; ++i) sem_collision_mesh_free(&c->objects[i].mesh);
+    free(c->colliders);
+    free(c->objects);
+    free(c->recs);
+    free(c->slots);
+    free(c->slot_count);
+    free(c->sys_to_contact);
+    free(c->friction);
+    free(c->fweights);
+    free(c->couplings);
+    sem_point_terms_free(&c->terms);
+    sem_point_terms_free(&c->friction_terms);
+    free(c);
+}
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void normalize3(double a[3])
+{
+    double l = sqrt(dot3(a, a));
+    if (l > 0)
+        for (int k = 0; k < 3; ++k) a[k] /= l;
+}
+
+typedef struct edge_key {
+    int a, b, slot; /* vertices a < b; slot = 3 triangle + edge */
+} edge_key;
+
+static int compare_edge(const void *x, const void *y)
+{
+    const edge_key *p = x, *q = y;
+    if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
+    if (p->b != q->b) return (p->b > q->b) - (p->b < q->b);
+    return (p->slot > q->slot) - (p->slot < q->slot);
+}
+
+/* Face, edge and vertex pseudonormals of a collider mesh: the sign of the distance to a
+ * closed (or terrain-like) mesh is that of (p - c) . pseudonormal at the closest feature. */
+static sem_status mesh_normals(collider *k, sem_error *err)
+{
+    size_t nt = (size_t)k->n_triangles;
+    k->face_normal = calloc(3 * nt + 1, sizeof(double));
+    k->edge_normal = calloc(9 * nt + 1, sizeof(double));
+    k->vertex_normal = calloc(3 * (size_t)k->n_vertices + 1, sizeof(double));
+    edge_key *edges = malloc((3 * nt + 1) * sizeof *edges);
+    if (!k->face_normal || !k->edge_normal || !k->vertex_normal || !edges) {
+        free(edges);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collider");
+    }
+    for (size_t t = 0; t < nt; ++t) {
+        const int *tri = k->triangles + 3 * t;
+        double *n = k->face_normal + 3 * t;
+        const double *x[3] = {k->vertices + 3 * (size_t)tri[0], k->vertices + 3 * (size_t)tri[1],
+                              k->vertices + 3 * (size_t)tri[2]};
+        double e1[3], e2[3];
+        for (int d = 0; d < 3; ++d) {
+            e1[d] = x[1][d] - x[0][d];
+            e2[d] = x[2][d] - x[0][d];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        normalize3(n);
+        for (int v = 0; v < 3; ++v) {
+            /* the triangle's angle at vertex v */
+            double a[3], b[3];
+            for (int d = 0; d < 3; ++d) {
+                a[d] = x[(v + 1) % 3][d] - x[v][d];
+                b[d] = x[(v + 2) % 3][d] - x[v][d];
+            }
+            normalize3(a);
+            normalize3(b);
+            double cosang = dot3(a, b);
+            double angle = acos(cosang < -1 ? -1 : cosang > 1 ? 1 : cosang);
+            for (int d = 0; d < 3; ++d) k->vertex_normal[3 * (size_t)tri[v] + d] += angle * n[d];
+            int p = tri[v], q = tri[(v + 1) % 3];
+            edges[3 * t + (size_t)v] = (edge_key){p < q ? p : q, p < q ? q : p, (int)(3 * t) + v};
+        }
+    }
+    qsort(edges, 3 * nt, sizeof *edges, compare_edge);
+    for (size_t i = 0; i < 3 * nt;) {
+        size_t j = i;
+        double sum[3] = {0, 0, 0};
+        while (j < 3 * nt && edges[j].a == edges[i].a && edges[j].b == edges[i].b) {
+            const double *n = k->face_normal + 3 * (size_t)(edges[j].slot / 3);
+            for (int d = 0; d < 3; ++d) sum[d] += n[d];
+            ++j;
+        }
+        normalize3(sum);
+        for (size_t e = i; e < j; ++e) memcpy(k->edge_normal + 3 * (size_t)edges[e].slot, sum, sizeof sum);
+        i = j;
+    }
+    for (int v = 0; v < k->n_vertices; ++v) normalize3(k->vertex_normal + 3 * (size_t)v);
+    free(edges);
+    return SEM_OK;
+}
+
+sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def, sem_error *err)
+{
+    if (!(def->friction >= 0) || !isfinite(def->friction))
+        return sem_error_set(err, SEM_ERR_INVALID, "collider friction must be >= 0 (got %g)", def->friction);
+    collider k;
+    memset(&k, 0, sizeof k);
+    k.type = def->type;
+    k.friction = def->friction;
+    if (def->type == SEM_COLLIDER_PLANE) {
+        memcpy(k.point, def->point, sizeof k.point);
+        memcpy(k.normal, def->normal, sizeof k.normal);
+        double l = sqrt(dot3(k.normal, k.normal));
+        if (!(l > 0) || !isfinite(l)) return sem_error_set(err, SEM_ERR_INVALID, "plane normal must be non-zero");
+        for (int d = 0; d < 3; ++d) {
+            k.normal[d] /= l;
+            if (!isfinite(k.point[d])) return sem_error_set(err, SEM_ERR_INVALID, "plane point must be finite");
+        }
+    } else if (def->type == SEM_COLLIDER_MESH) {
+        if (def->n_triangles <= 0 || def->n_vertices <= 0 || !def->vertices || !def->triangles)
+            return sem_error_set(err, SEM_ERR_INVALID, "collider mesh has no triangle");
+        for (int t = 0; t < 3 * def->n_triangles; ++t)
+            if (def->triangles[t] < 0 || def->triangles[t] >= def->n_vertices)
+                return sem_error_set(err, SEM_ERR_INVALID, "collider mesh triangle %d has a vertex index out of range",
+                                     t / 3);
+        for (int v = 0; v < 3 * def->n_vertices; ++v)
+            if (!isfinite(def->vertices[v]))
+                return sem_error_set(err, SEM_ERR_INVALID, "collider mesh vertex %d is not finite", v / 3);
+        k.n_vertices = def->n_vertices;
+        k.n_triangles = def->n_triangles;
+        k.vertices = malloc(3 * (size_t)k.n_vertices * sizeof(double));
+        k.triangles = malloc(3 * (size_t)k.n_triangles * sizeof(int));
+        if (!k.vertices || !k.triangles) {
+            collider_free(&k);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collider");
+        }
+        memcpy(k.vertices, def->vertices, 3 * (size_t)k.n_vertices * sizeof(double));
+        memcpy(k.triangles, def->triangles, 3 * (size_t)k.n_triangles * sizeof(int));
+        sem_status st = mesh_normals(&k, err);
+        if (st == SEM_OK) st = sem_bvh_build(&k.bvh, k.vertices, k.triangles, k.n_triangles, err);
+        if (st != SEM_OK) {
+            collider_free(&k);
+            return st;
+        }
+    } else
+        return sem_error_set(err, SEM_ERR_INVALID, "unknown collider type %d", (int)def->type);
+    if (c->n_colliders == c->cap_colliders) {
+        int cap = c->cap_colliders ? 2 * c->cap_colliders : 4;
+        collider *x = realloc(c->colliders, (size_t)cap * sizeof *x);
+        if (!x) {
+            collider_free(&k);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
+        c->colliders = x;
+        c->cap_colliders = cap;
+    }
+    c->colliders[c->n_colliders++] = k;
+    c->stats.colliders = c->n_colliders;
+    return SEM_OK;
+}
+
+sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error *err)
+{
+    if (c->n_objects == c->cap_objects) {
+        int cap = c->cap_objects ? 2 * c->cap_objects : 4;
+        contact_object *x = realloc(c->objects, (size_t)cap * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        c->objects = x;
+        c->cap_objects = cap;
+    }
+    contact_object *co = &c->objects[c->n_objects];
+    memset(co, 0, sizeof *co);
+    co->object = o;
+    c->n_objects++;
+    return SEM_OK; /* its mesh is built when contact first needs it (mesh_for) */
+}
+
+/* The collision mesh of contact object i, built on first use: a world with one object and
+ * no collider never pays for it. */
+static sem_status mesh_for(sem_contact *c, int i, sem_error *err)
+{
+    contact_object *co = &c->objects[i];
+    if (co->built) return SEM_OK;
+    const sem_object *o = co->object;
+    sem_status st = sem_collision_mesh_build(o->def.model, c->def.resolution, &co->mesh, err);
+    if (st != SEM_OK) return st;
+    co->youngs = o->def.material.youngs_modulus;
+    co->friction = o->def.friction;
+    co->length = co->mesh.length > 0 ? co->mesh.length : 1.0;
+    co->thickness = c->def.thickness > 0 ? c->def.thickness : DEFAULT_THICKNESS * co->length;
+    co->built = 1;
+    return SEM_OK;
+}
+
+void sem_contact_remove_last_object(sem_contact *c)
+{
+    if (c->n_objects > 0) sem_collision_mesh_free(&c->objects[--c->n_objects].mesh);
+}
+
+int sem_contact_between_objects(const sem_contact *c) { return !c->def.disabled && c->n_objects >= 2; }
+
+int sem_contact_active(const sem_contact *c)
+{
+    return !c->def.disabled && (c->n_colliders > 0 || c->n_objects >= 2);
+}
+
+const sem_point_terms *sem_contact_terms(const sem_contact *c) { return &c->terms; }
+
+void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out) { *out = c->stats; }
+
+/* ---------------------------------------------------------------------------------- */
+/* detection                                                                           */
+
+/* contact_object of each of the system's objects */
+static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err)
+{
+    if (c->n_sys < s->n_objects) {
+        int *x = realloc(c->sys_to_contact, (size_t)s->n_objects * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        c->sys_to_contact = x;
+    }
+    c->n_sys = s->n_objects;
+    for (int k = 0; k < s->n_objects; ++k) {
+        c->sys_to_contact[k] = -1;
+        for (int i = 0; i < c->n_objects; ++i)
+            if (c->objects[i].object == s->objects[k]) c->sys_to_contact[k] = i;
+        if (c->sys_to_contact[k] < 0)
+            return sem_error_set(err, SEM_ERR_INVALID, "contact: an object of the system is not in the world");
+        sem_status st = mesh_for(c, c->sys_to_contact[k], err);
+        if (st != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
+static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
+{
+    if (c->n_recs == c->cap_recs) {
+        int cap = c->cap_recs ? 2 * c->cap_recs : 256;
+        contact_rec *x = realloc(c->recs, (size_t)cap * sizeof *x);
+        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+        c->recs = x;
+        c->cap_recs = cap;
+    }
+    c->recs[c->n_recs++] = *r;
+    return SEM_OK;
+}
+
+/* The contacts of point p of system object k (thickness + margin x the search radius,
+ * margin 0: the active ones) into out (at most n_colliders + n_objects - 1); returns their
+ * count and lowers *min_gap. */
+static int point_contacts(const sem_contact *c, const sem_system *s, int k, int p, double margin, contact_rec *out,
+                          double *min_gap)
+{
+    const contact_object *co = &c->objects[c->sys_to_contact[k]];
+    const sem_collision_mesh *m = &co->mesh;
+    double th = co->thickness, L = co->length;
+    double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
+    double radius = th + SEARCH_DEPTH * L;
+    /* how far to look: the search radius, or the contacts within th + margin x radius */
+    double reach = margin > 1 ? th + margin * radius : radius, reach2 = reach * reach;
+    const double *x = m->x + 3 * (size_t)p;
+    int n = 0;
+    for (int i = 0; i < c->n_colliders; ++i) {
+        const collider *col = &c->colliders[i];
+        contact_rec r = {k, p, -1, i, -1, {0, 0, 0}, 0, {0, 0, 0}, 0, th, 0};
+        if (col->type == SEM_COLLIDER_PLANE) {
+            double diff[3] = {x[0] - col->point[0], x[1] - col->point[1], x[2] - col->point[2]};
+            r.d = dot3(diff, col->normal);
+            memcpy(r.n, col->normal, sizeof r.n);
+        } else {
+            sem_tri_closest cl;
+            int t = sem_bvh_closest(&col->bvh, col->vertices, col->triangles, x, reach2, &cl);
+            if (t < 0) continue;
+            const double *outward = cl.feature == SEM_TRI_FACE   ? col->face_normal + 3 * (size_t)t
+                                    : cl.feature == SEM_TRI_EDGE ? col->edge_normal + 9 * (size_t)t + 3 * cl.index
+                                                                 : col->vertex_normal +
+                                                                       3 * (size_t)col->triangles[3 * t + cl.index];
+            r.d = sem_signed_distance(x, cl.point, outward, r.n);
+        }
+        if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
+        if (!(r.d < th + margin * radius)) continue;
+        r.stiffness = own_stiffness * m->area[p];
+        r.mu = sqrt(co->friction * col->friction);
+        out[n++] = r;
+    }
+    if (s->n_objects < 2) return n;
+    for (int j = 0; j < s->n_objects; ++j) {
+        if (j == k) continue;
+        const contact_object *cj = &c->objects[c->sys_to_contact[j]];
+        const sem_collision_mesh *mj = &cj->mesh;
+        sem_tri_closest cl;
+        int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, reach2, &cl);
+        if (t < 0) continue;
+        contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
+        const int *tri = mj->triangles + 3 * t;
+        double outward[3] = {0, 0, 0};
+        if (cl.feature == SEM_TRI_FACE) {
+            const double *a = mj->x + 3 * (size_t)tri[0], *b = mj->x + 3 * (size_t)tri[1], *cc = mj->x + 3 * (size_t)tri[2];
+            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+            outward[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            outward[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            outward[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        } else
+            for (int v = 0; v < 3; ++v)
+                if (cl.bary[v] > 0)
+                    for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
+        r.d = sem_signed_distance(x, cl.point, outward, r.n);
+        if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
+        if (!(r.d < th + margin * radius)) continue;
+        double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
+        r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
+        r.mu = sqrt(co->friction * cj->friction);
+        out[n++] = r;
+    }
+    return n;
+}
+
+/* Every contact at the system's vector q closer than thickness + margin x the search
+ * radius (margin 0: the active ones) into c->recs, and c->min_gap. Points are tested in
+ * parallel, each into slots of its own, and the slots are gathered in point order: the
+ * list is the same on any thread count. */
+static sem_status detect(sem_contact *c, const sem_system *s, const double *q, double margin, sem_error *err)
+{
+    sem_status st = map_system(c, s, err);
+    if (st != SEM_OK) return st;
+    c->n_recs = 0;
+    c->min_gap = INFINITY;
+    if (c->def.disabled) return SEM_OK;
+    int between = s->n_objects >= 2;
+    for (int k = 0; k < s->n_objects; ++k)
+        sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
+    int per_point = c->n_colliders + s->n_objects - 1;
+    if (per_point <= 0) return SEM_OK;
+    int nthreads = s->n_objects > 0 ? s->objects[0]->nthreads : 1;
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_collision_mesh *m = &c->objects[c->sys_to_contact[k]].mesh;
+        size_t need = (size_t)m->n_points * (size_t)per_point;
+        if (need > c->cap_slots) {
+            contact_rec *x = realloc(c->slots, need * sizeof *x);
+            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+            c->slots = x;
+            c->cap_slots = need;
+        }
+        if (m->n_points > c->cap_count) {
+            int *y = realloc(c->slot_count, (size_t)m->n_points * sizeof *y);
+            if (!y) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
+            c->slot_count = y;
+            c->cap_count = m->n_points;
+        }
+        double gap = INFINITY;
+#pragma omp parallel for schedule(static) reduction(min : gap) num_threads(nthreads)
+        for (int p = 0; p < m->n_points; ++p) {
+            c->slot_count[p] = 0;
+            if (m->area[p] > 0)
+                c->slot_count[p] =
+                    point_contacts(c, s, k, p, margin, c->slots + (size_t)p * (size_t)per_point, &gap);
+        }
+        if (gap < c->min_gap) c->min_gap = gap;
+        for (int p = 0; p < m->n_points; ++p)
+            for (int i = 0; i < c->slot_count[p]; ++i)
+                if ((st = push_rec(c, &c->slots[(size_t)p * (size_t)per_point + (size_t)i], err)) != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
+/* The weights of a contact's relative point: its point's row (+phi), and for a contact
+ * with another object that object's triangle rows (-bary phi). Returns the count. */
+static int rec_weights(const sem_contact *c, const contact_rec *r, sem_point_weight *w)
+{
+    const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
+    int n = 0;
+    for (int e = m->row_start[r->point]; e < m->row_start[r->point + 1] && n < MAX_WEIGHTS; ++e)
+        w[n++] = (sem_point_weight){r->k, m->row_ctrl[e], m->row_w[e]};
+    if (r->other >= 0) {
+        const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
+        for (int v = 0; v < 3; ++v) {
+            if (r->bary[v] == 0) continue;
+            int p = mo->triangles[3 * r->triangle + v];
+            for (int e = mo->row_start[p]; e < mo->row_start[p + 1] && n < MAX_WEIGHTS; ++e)
+                w[n++] = (sem_point_weight){r->other, mo->row_ctrl[e], -r->bary[v] * mo->row_w[e]};
+        }
+    }
+    return n;
+}
+
+static void add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad)
+{
+    for (int i = 0; i < n; ++i) {
+        double *g = grad + s->dof_offset[w[i].object] + 3 * (size_t)w[i].ctrl;
+        for (int d = 0; d < 3; ++d) g[d] += w[i].w * f[d];
+    }
+}
+
+static void relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
+{
+    X[0] = X[1] = X[2] = 0;
+    for (int i = 0; i < n; ++i) {
+        const double *x = q + s->dof_offset[w[i].object] + 3 * (size_t)w[i].ctrl;
+        for (int d = 0; d < 3; ++d) X[d] += w[i].w * x[d];
+    }
+}
+
+/* Springs at the last detection: energy; gradient into grad and Hessian into terms when
+ * grad is given. With v (the linearly implicit step's velocities, h its step), a contact
+ * not active yet but predicted to be at q + h v is a speculative one: its spring is the
+ * linear extension of the active one (a pull towards the surface, to be reached within
+ * the step; Box2D's speculative contacts), so a fast point stops at the surface instead of
+ * sinking in for a step and being thrown out by a stiff spring the next. */
+static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem_point_terms *terms, double *energy,
+                          const double *v, double h, sem_error *err)
+{
+    sem_point_weight w[MAX_WEIGHTS];
+    double E = 0;
+    for (int i = 0; i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        double slope;
+        E += sem_penalty_energy(r->stiffness, r->d, r->thickness, &slope);
+        int n = 0;
+        if (v && !(r->d < r->thickness)) {
+            double X[3];
+            n = rec_weights(c, r, w);
+            relative_point(s, w, n, v, X);
+            if (!(r->d + h * dot3(X, r->n) < r->thickness)) continue;
+            slope = r->stiffness * (r->d - r->thickness);
+        } else if (!(r->d < r->thickness))
+            continue;
+        if (!grad) continue;
+        if (n == 0) n = rec_weights(c, r, w);
+        double f[3] = {slope * r->n[0], slope * r->n[1], slope * r->n[2]};
+        add_gradient(s, w, n, f, grad);
+        double H[9] = {0};
+        sem_penalty_hessian(r->stiffness, r->n, H);
+        sem_status st = sem_point_terms_push(terms, w, n, H, err);
+        if (st != SEM_OK) return st;
+    }
+    *energy = E;
+    return SEM_OK;
+}
+
+/* Friction of the step at q: energy; gradient and Hessian terms when grad is given. */
+static sem_status friction(sem_contact *c, const sem_system *s, const double *q, double *grad,
+                           sem_point_terms *terms, double *energy, sem_error *err)
+{
+    double E = 0;
+    if (!(c->friction_eps > 0)) {
+        *energy = 0;
+        return SEM_OK;
+    }
+    for (int i = 0; i < c->n_friction; ++i) {
+        const friction_rec *fr = &c->friction[i];
+        const sem_point_weight *w = c->fweights + fr->first;
+        double X[3], u[2], g[2], Hu[4];
+        relative_point(s, w, fr->count, q, X);
+        for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
+        u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
+        u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
+        E += sem_friction_potential(fr->mu_lambda, u, c->friction_eps, grad ? g : NULL, grad ? Hu : NULL);
+        if (!grad) continue;
+        double f[3], H[9];
+        for (int a = 0; a < 3; ++a) {
+            f[a] = fr->T[2 * a] * g[0] + fr->T[2 * a + 1] * g[1];
+            for (int b = 0; b < 3; ++b) {
+                /* T Hu T^T */
+                double ta0 = fr->T[2 * a], ta1 = fr->T[2 * a + 1], tb0 = fr->T[2 * b], tb1 = fr->T[2 * b + 1];
+                H[3 * a + b] = ta0 * (Hu[0] * tb0 + Hu[1] * tb1) + ta1 * (Hu[2] * tb0 + Hu[3] * tb1);
+            }
+        }
+        add_gradient(s, w, fr->count, f, grad);
+        sem_status st = sem_point_terms_push(terms, w, fr->count, H, err);
+        if (st != SEM_OK) return st;
+    }
+    *energy = E;
+    return SEM_OK;
+}
+
+/* Friction for the linearly implicit step, as a damper: each contact's tangential motion
+ * u = h T^T J v+ over the step meets the force -c u, c = mu lambda f1(y) / y at the slip
+ * y = |u| predicted from v_n (friction.h). Sliding steadily, |u| = y and the force is
+ * exactly mu lambda (Coulomb); sticking, c = 2 mu lambda / eps holds the contact. Linear in
+ * v+ and dissipative, so the step stays stable; the tangent linearization about v_n (the
+ * Newton Hessian) instead extrapolates a saturating force and throws objects apart when
+ * their relative velocity changes within a step (an impact). Only the matrix changes:
+ * h^2 c J^T T T^T J. */
+static sem_status friction_damper(sem_contact *c, const sem_system *s, const double *qpred, sem_point_terms *terms,
+                                  sem_error *err)
+{
+    if (!(c->friction_eps > 0)) return SEM_OK;
+    for (int i = 0; i < c->n_friction; ++i) {
+        const friction_rec *fr = &c->friction[i];
+        const sem_point_weight *w = c->fweights + fr->first;
+        double X[3], u[2], g[2];
+        relative_point(s, w, fr->count, qpred, X);
+        for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
+        u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
+        u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
+        double y = sqrt(u[0] * u[0] + u[1] * u[1]), damping;
+        if (y > 0) {
+            sem_friction_potential(fr->mu_lambda, u, c->friction_eps, g, NULL);
+            damping = sqrt(g[0] * g[0] + g[1] * g[1]) / y;
+        } else
+            damping = 2 * fr->mu_lambda / c->friction_eps;
+        double H[9];
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                H[3 * a + b] = damping * (fr->T[2 * a] * fr->T[2 * b] + fr->T[2 * a + 1] * fr->T[2 * b + 1]);
+        sem_status st = sem_point_terms_push(terms, w, fr->count, H, err);
+        if (st != SEM_OK) return st;
+    }
+    return SEM_OK;
+}
+
+/* The system's objects' a q + b v as one vector (the caller frees). */
+static double *system_q(const sem_system *s, double a, double b)
+{
+    double *q = malloc(s->n_dofs * sizeof(double) + 1);
+    if (!q) return NULL;
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        double *x = q + s->dof_offset[k];
+        for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) x[i] = a * o->q[i] + b * o->v[i];
+    }
+    return q;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* the step                                                                            */
+
+/* The coupling blocks contact between objects needs at q (contacts within the search
+ * radius: a superset of those a step's iterates can activate), in c->couplings. */
+static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_error *err)
+{
+    c->n_couplings = 0;
+    for (int i = 0; i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        if (r->other < 0) continue;
+        const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
+        const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
+        int ga = s->objects[r->k]->ctrl_group[m->row_ctrl[m->row_start[r->point]]];
+        int p = mo->triangles[3 * r->triangle];
+        int gb = s->objects[r->other]->ctrl_group[mo->row_ctrl[mo->row_start[p]]];
+        sem_system_coupling cp = r->k < r->other ? (sem_system_coupling){r->k, ga, r->other, gb}
+                                                 : (sem_system_coupling){r->other, gb, r->k, ga};
+        int seen = 0;
+        for (int j = 0; j < c->n_couplings && !seen; ++j)
+            seen = !memcmp(&c->couplings[j], &cp, sizeof cp);
+        if (seen) continue;
+        if (c->n_couplings == c->cap_couplings) {
+            int cap = c->cap_couplings ? 2 * c->cap_couplings : 64;
+            sem_system_coupling *x = realloc(c->couplings, (size_t)cap * sizeof *x);
+            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            c->couplings = x;
+            c->cap_couplings = cap;
+        }
+        c->couplings[c->n_couplings++] = cp;
+    }
+    return SEM_OK;
+}
+
+sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h, sem_solver_choice solver,
+                                  sem_error *err)
+{
+    const sem_system *s = *system;
+    c->stats.seconds = 0;
+    c->n_friction = 0;
+    c->n_fweights = 0;
+    c->friction_eps = 0;
+    if (!sem_contact_active(c)) return SEM_OK;
+    /* the structured solver (physics/structured.h) has no matrix to take point terms yet:
+     * without the contact Hessian Newton would crawl and the linearly implicit step would
+     * be explicit in the springs */
+    if (s->structured)
+        return sem_error_set(err, SEM_ERR_UNSUPPORTED,
+                             "contact needs the sparse or dense solver for now (integrator.solver); the structured "
+                             "solver does not take contact terms yet");
+    double t0 = omp_get_wtime();
+    double *q = system_q(s, 1, 0);
+    if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_status st = detect(c, s, q, s->n_objects > 1 ? 1 : 0, err);
+    /* objects near each other: their coupling blocks in the system's pattern (a new system
+     * when some are missing; point_terms.h) */
+    if (st == SEM_OK && s->n_objects > 1) st = needed_couplings(c, s, err);
+    if (st == SEM_OK && s->n_objects > 1) {
+        int missing = 0;
+        for (int i = 0; i < c->n_couplings && !missing; ++i)
+            missing = sem_system_find_coupling(s, c->couplings[i].a, c->couplings[i].ga, c->couplings[i].b,
+                                               c->couplings[i].gb) < 0;
+        if (missing) {
+            /* ask for the blocks of parts up to three search radii apart, so that objects
+             * approaching each other do not need a new system every step */
+            if ((st = detect(c, s, q, 3, err)) == SEM_OK) st = needed_couplings(c, s, err);
+            if (st == SEM_OK) st = detect(c, s, q, 1, err); /* the step's contacts again */
+        }
+        if (missing && st == SEM_OK) {
+            sem_system *ns = NULL;
+            st = sem_system_create_coupled(s->objects, s->n_objects, c->couplings, c->n_couplings, solver, &ns, err);
+            if (st == SEM_OK) {
+                sem_system_destroy(*system);
+                *system = ns;
+                s = ns;
+                c->rebuilds++;
+            } else /* the objects point to the system they had */
+                for (int k = 0; k < s->n_objects; ++k) s->objects[k]->system = *system;
+        }
+    }
+    c->friction_eps = h > 0 ? c->def.friction_velocity * h : 0;
+    sem_point_weight w[MAX_WEIGHTS];
+    for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < c->n_recs; ++i) {
+        const contact_rec *r = &c->recs[i];
+        double lambda = r->stiffness * (r->thickness - r->d);
+        if (!(r->mu > 0) || !(lambda > 0)) continue;
+        int n = rec_weights(c, r, w);
+        if (c->n_friction == c->cap_friction) {
+            int cap = c->cap_friction ? 2 * c->cap_friction : 256;
+            friction_rec *x = realloc(c->friction, (size_t)cap * sizeof *x);
+            if (!x) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+                break;
+            }
+            c->friction = x;
+            c->cap_friction = cap;
+        }
+        if (c->n_fweights + n > c->cap_fweights) {
+            int cap = c->cap_fweights ? 2 * c->cap_fweights : 4096;
+            while (cap < c->n_fweights + n) cap *= 2;
+            sem_point_weight *x = realloc(c->fweights, (size_t)cap * sizeof *x);
+            if (!x) {
+                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+                break;
+            }
+            c->fweights = x;
+            c->cap_fweights = cap;
+        }
+        friction_rec *fr = &c->friction[c->n_friction++];
+        fr->first = c->n_fweights;
+        fr->count = n;
+        memcpy(c->fweights + c->n_fweights, w, (size_t)n * sizeof *w);
+        c->n_fweights += n;
+        sem_tangent_basis(r->n, fr->T);
+        relative_point(s, w, n, q, fr->X0);
+        fr->mu_lambda = r->mu * lambda;
+    }
+    free(q);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st;
+}
+
+double sem_contact_potential(sem_contact *c, const sem_system *s, const double *q, double h, double *grad,
+                             sem_error *err)
+{
+    if (grad) sem_point_terms_clear(&c->terms);
+    if (!sem_contact_active(c)) return 0;
+    double t0 = omp_get_wtime();
+    double Es = 0, Ef = 0;
+    sem_status st = detect(c, s, q, 0, err);
+    if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, NULL, 0, err);
+    if (st == SEM_OK && h > 0) st = friction(c, s, q, grad, &c->terms, &Ef, err);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st == SEM_OK ? Es + Ef : NAN;
+}
+
+sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, double *rhs, sem_error *err)
+{
+    if (!sem_contact_active(c)) return SEM_OK;
+    double t0 = omp_get_wtime();
+    sem_status st = SEM_OK;
+    double *q = system_q(s, 1, 0), *qpred = system_q(s, 1, h), *v = system_q(s, 0, 1);
+    double *g = calloc(s->n_dofs + 1, sizeof(double));
+    double E;
+    if (!q || !qpred || !v || !g) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    /* springs at q_n (as the elastic forces): h^2 H in the matrix, h f on the right */
+    sem_point_terms_clear(&c->terms);
+    if ((st = detect(c, s, q, 1, err)) != SEM_OK) goto done;
+    if ((st = springs(c, s, g, &c->terms, &E, v, h, err)) != SEM_OK) goto done;
+    /* friction as a damper lagged from the predicted slip (friction_damper) */
+    sem_point_terms_clear(&c->friction_terms);
+    if ((st = friction_damper(c, s, qpred, &c->friction_terms, err)) != SEM_OK) goto done;
+    {
+        const sem_point_terms *lists[2] = {&c->terms, &c->friction_terms};
+        const double scale[2] = {h * h, h * h};
+        sem_system_set_point_terms(s, lists, scale, 2);
+    }
+    for (size_t i = 0; i < s->n_dofs; ++i) rhs[i] -= h * g[i];
+done:
+    free(q);
+    free(qpred);
+    free(v);
+    free(g);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return st;
+}
+
+void sem_contact_end_step(sem_contact *c, const sem_system *s)
+{
+    c->stats.contacts = 0;
+    c->stats.min_gap = INFINITY;
+    if (!sem_contact_active(c)) return;
+    double t0 = omp_get_wtime();
+    double *q = system_q(s, 1, 0);
+    sem_error err;
+    if (q && detect(c, s, q, 0, &err) == SEM_OK) {
+        c->stats.contacts = c->n_recs;
+        c->stats.min_gap = c->min_gap;
+    }
+    free(q);
+    c->stats.seconds += omp_get_wtime() - t0;
+}
+
+sem_collider_def sem_default_collider_def(void)
+{
+    sem_collider_def d;
+    memset(&d, 0, sizeof d);
+    d.type = SEM_COLLIDER_PLANE;
+    d.normal[2] = 1;
+    d.friction = SEM_DEFAULT_FRICTION;
+    return d;
+}
