@@ -64,6 +64,11 @@ const double *sem_centered(sem_object *o, const double *q);
 /* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties) and their CSR
  * copy. */
 sem_status sem_mass_error_init(sem_object *o, sem_error *err);
+/* The boundary samples' weights in the error matrix: their areas, each at least 5 % of its
+ * part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area element
+ * and its samples would drop out, and with them the only information that fixes the control
+ * points of the collapsed row (the system would be singular). weight: n_samples. */
+sem_status sem_sample_weights(const sem_object *o, double *weight, sem_error *err);
 /* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (into grad). */
 double sem_error_energy(sem_object *o, const double *q, double *grad);
 /* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all the object's dofs. */

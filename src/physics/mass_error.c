@@ -66,6 +66,29 @@ static void add_projected(const sem_object *o, int pa, int pb, const double *X, 
                 nb, 1.0, block, nb);
 }
 
+sem_status sem_sample_weights(const sem_object *o, double *weight, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
+    int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
+    if (!part_mean || !part_count) {
+        free(part_mean);
+        free(part_count);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int r = 0; r < d->n_samples; ++r) {
+        part_mean[d->sample_part[r]] += d->sample_area[r];
+        part_count[d->sample_part[r]]++;
+    }
+    for (int i = 0; i < o->n_parts; ++i)
+        if (part_count[i]) part_mean[i] /= part_count[i];
+    for (int r = 0; r < d->n_samples; ++r)
+        weight[r] = fmax(d->sample_area[r], 0.05 * part_mean[d->sample_part[r]]);
+    free(part_mean);
+    free(part_count);
+    return SEM_OK;
+}
+
 /* Control points that no boundary sample sees (their basis functions are supported only
  * where a trim removed the surface) appear in no term of the discretization, so the system
  * would be singular. Each such point is tied to its own part's polynomial at its rest
@@ -227,25 +250,14 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
             free(rv);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
-        /* A collapsed edge (a sphere's pole) has a zero area element, so its samples would
-         * drop out, and with them the only information that fixes the control points of the
-         * collapsed row: the system becomes singular. Every sample keeps at least 5% of its
-         * part's mean sample weight. */
-        double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
-        int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
-        if (!part_mean || !part_count) {
-            free(part_mean);
-            free(part_count);
+        double *weight = malloc(((size_t)o->d->n_samples + 1) * sizeof(double));
+        sem_status st = weight ? sem_sample_weights(o, weight, err) : sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        if (st != SEM_OK) {
+            free(weight);
             free(rc);
             free(rv);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            return st;
         }
-        for (int r = 0; r < o->d->n_samples; ++r) {
-            part_mean[o->d->sample_part[r]] += o->d->sample_area[r];
-            part_count[o->d->sample_part[r]]++;
-        }
-        for (int i = 0; i < o->n_parts; ++i)
-            if (part_count[i]) part_mean[i] /= part_count[i];
         for (int r = 0; r < G->n_rows; ++r) {
             /* merge the sorted rows of Gamma_s and J_s */
             int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
@@ -262,7 +274,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                     rv[n++] = G->val[a++] - J->val[b++];
                 }
             }
-            double area = fmax(o->d->sample_area[r], 0.05 * part_mean[o->d->sample_part[r]]);
+            double area = weight[r];
             for (int x = 0; x < n; ++x) {
                 int gx = o->ctrl_group[rc[x]];
                 double ax = area * rv[x];
@@ -271,8 +283,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                     int gy = o->ctrl_group[rc[y]];
                     int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
                     if (gp < 0) {
-                        free(part_mean);
-                        free(part_count);
+                        free(weight);
                         free(rc);
                         free(rv);
                         return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
@@ -283,8 +294,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                 }
             }
         }
-        free(part_mean);
-        free(part_count);
+        free(weight);
         free(rc);
         free(rv);
     }

@@ -75,25 +75,10 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     s->area = malloc(((size_t)nr + 1) * sizeof(double));
     s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
     s->g_start = malloc(((size_t)nr + 1) * sizeof(int));
-    double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
-    int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
-    if (!s->area || !s->j_start || !s->g_start || !part_mean || !part_count) {
-        free(part_mean);
-        free(part_count);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    /* every sample keeps at least 5 % of its part's mean weight (a collapsed edge; see
-     * mass_error.c) */
-    for (int r = 0; r < ns; ++r) {
-        part_mean[d->sample_part[r]] += d->sample_area[r];
-        part_count[d->sample_part[r]]++;
-    }
-    for (int i = 0; i < o->n_parts; ++i)
-        if (part_count[i]) part_mean[i] /= part_count[i];
-    for (int r = 0; r < ns; ++r) s->area[r] = fmax(d->sample_area[r], 0.05 * part_mean[d->sample_part[r]]);
+    if (!s->area || !s->j_start || !s->g_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_status st = sem_sample_weights(o, s->area, err); /* mass_error.c's floor */
+    if (st != SEM_OK) return st;
     for (int t = 0; t < n_ties; ++t) s->area[ns + t] = tie_weight;
-    free(part_mean);
-    free(part_count);
     s->j_start[0] = s->g_start[0] = 0;
     for (int r = 0; r < ns; ++r) {
         s->j_start[r + 1] = s->j_start[r] + (J->row_start[r + 1] - J->row_start[r]);
