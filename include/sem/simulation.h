@@ -49,6 +49,10 @@ typedef struct sem_world_advanced {
     int solve_together;    /* 1: every object in one linear system (what contact will need;
                               objects do not interact yet, so the motion is the same up to
                               round-off and Newton's joint stopping test) */
+    int refactorize;       /* 1: the linearly implicit step factorizes its matrix every step
+                              (the paper's way); 0 (default): it reuses the rest matrix's
+                              factor while the stiffness stays near its rest value
+                              (src/physics/integrators.c, "Reusing the rest factor") */
 } sem_world_advanced;
 
 typedef struct sem_world_def {

@@ -52,6 +52,29 @@ sem_status sem_assembly_init(sem_object *o, int assembly_chunk, sem_error *err);
  * undefined (an inverted element, a non-finite state). */
 sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                 const sem_fill_target *fill, sem_error *err);
+/* want_hessian: none, the coefficient-space blocks Kz only, or Kz and the q-space K_blocks
+ * (with the fill). */
+enum { SEM_HESSIAN_NONE = 0, SEM_HESSIAN_FULL = 1, SEM_HESSIAN_Z = 2, SEM_HESSIAN_POINTS = 3 };
+/* (SEM_HESSIAN_POINTS keeps each point's (projected) d2psi/dF2 in o->point_H instead, for
+ * the products below; q-space objects only.) Kz from the kept point Hessians. */
+void sem_assemble_kz_from_points(sem_object *o);
+/* |H - H0| / |H0| over the points (volume-weighted Frobenius norms), H0 the rest Hessians. */
+double sem_point_hessian_change(const sem_object *o);
+/* y += c K x from the kept point Hessians (minus_rest: c (K - K0) x) without forming K.
+ * work: (1 + GRADIENT_SHARES) n_parts 3 ma doubles. */
+void sem_point_hessian_multiply(const sem_object *o, double c, int minus_rest, const double *x, double *y,
+                                double *work);
+/* The q-space stage alone, from the current Kz: K_blocks (and the fill), or, for a
+ * structured object, the fill's coefficients. */
+sem_status sem_assemble_stiffness_blocks(sem_object *o, const sem_fill_target *fill, sem_error *err);
+/* z = pi_shared x (per part ma x 3, coordinates interleaved), x over all control points. */
+void sem_shared_coefficients(const sem_object *o, const double *x, double *z);
+/* y += pi_shared^T z. */
+void sem_shared_add_transpose(const sem_object *o, const double *z, double *y);
+/* y += pi_shared^T (ca Ka + cb Kb) pi_shared x with Ka, Kb laid out as o->Kz (Kb may be
+ * NULL). work: 2 n_parts 3 ma doubles. */
+void sem_stiffness_z_multiply(const sem_object *o, double ca, const double *Ka, double cb, const double *Kb,
+                              const double *x, double *y, double *work);
 /* T (m x m, row-major) with b(y + s) = T b(y): from a part's own basis b(X - Xbar_i),
  * s = ref_X - Xbar_i, to the shared one b(X - ref_X) (see setup_stiffness in assembly.c). */
 void sem_basis_shift(int m, const double s[3], double *T);

@@ -14,6 +14,137 @@
 #include "loads.h"
 #include "runaway.h"
 
+/*
+ * Reusing the rest factor. The step's matrix is A = R + h^2 (K(q_n) - K0) with the rest matrix
+ * R = (1 + h a) M + 2 h^2 gamma M_eps + (h^2 + h b) K0: everything but the stiffness is
+ * constant, and a stiff object (steel, the stiff mug) barely changes its stiffness from its
+ * rest shape. Factorizing A every step (the paper's way; 80 % of the stiff mug's step) is
+ * then wasted: R is factorized once, and the step solves A v = b by iterative refinement with
+ * R's factor: r = b - R v - h^2 (K - K0) v, v += R^-1 r, until the componentwise backward
+ * error max_i |r_i| / (|R| |v| + |h^2 (K - K0) v| + |b|)_i is below REST_TOLERANCE (a direct
+ * solve with one refinement step, the other path, reaches about the same). The products
+ * with K - K0 are matrix-free, point by point from the kept point Hessians (assembly.h,
+ * SEM_HESSIAN_POINTS), so such a step forms neither K's coefficient-space blocks nor its
+ * q-space ones. Each pass shrinks the error by about |R^-1 h^2 (K - K0)|; when that is not
+ * fast (a large deformation or rotation) the step forms K and factorizes A, as before.
+ *
+ * Whether a step tries R is decided from the state alone (the relative change of the point
+ * Hessians from rest, at most REST_MAX_CHANGE), and R is a function of the scene, not of the
+ * run's history: a resumed run takes the same path step by step and gives the same bits
+ * (docs/scenes.md, "Interrupted runs"). Systems with contact (point terms in the matrix)
+ * and structured systems (their own factorization, structured.h) always factorize.
+ */
+#define REST_MAX_CHANGE 0.5
+#define REST_TOLERANCE 1e-14
+#define REST_INNER_REDUCTION 1e-6
+#define REST_MAX_SOLVES 24
+
+/* In index order: the same bits on any thread count. */
+static double dot(const double *a, const double *b, size_t n)
+{
+    double s = 0;
+    for (size_t i = 0; i < n; ++i) s += a[i] * b[i];
+    return s;
+}
+
+/* y = h^2 (K - K0) x over the free dofs (x, y free vectors; full and work scratch). */
+static void stiffness_change_multiply(sem_system *s, double h, const double *x, double *y, double *full,
+                                      double *yfull, double *work)
+{
+    memset(full, 0, s->n_dofs * sizeof(double));
+    memset(yfull, 0, s->n_dofs * sizeof(double));
+    sem_system_scatter_free(s, x, full);
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k];
+        sem_point_hessian_multiply(o, h * h, 1, full + off, yfull + off, work);
+    }
+    sem_system_gather_free(s, yfull, y);
+}
+
+/* Solves A x = b by refinement with the rest factor (see above). *solved = 0 when it did not
+ * converge (x is then undefined and the caller factorizes A); errors are real failures. */
+static sem_status solve_with_rest(sem_world *w, sem_system *s, const double *b, double *x, int *solved,
+                                  sem_error *err)
+{
+    double h = w->def.dt, a = w->def.rayleigh_mass, bd = w->def.rayleigh_stiffness;
+    size_t nf = 3 * (size_t)s->n_free;
+    *solved = 0;
+    int factored = 0;
+    sem_status st = sem_system_factorize_rest(s, 1.0 + h * a, h * h, h * h + h * bd, &factored, err);
+    if (factored) {
+        w->last_factor_s += sem_system_rest_factor_seconds(s);
+        w->counters.factorizations++;
+    }
+    if (st != SEM_OK) return st;
+    size_t wz = 0;
+    for (int k = 0; k < s->n_objects; ++k) {
+        size_t need = (1 + GRADIENT_SHARES) * (size_t)s->objects[k]->n_parts * 3 * s->objects[k]->ma;
+        if (need > wz) wz = need;
+    }
+    double *r = malloc((9 * nf + 2 * s->n_dofs + wz + 1) * sizeof(double));
+    if (!r) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    double *y = r + nf, *sc = y + nf, *d = sc + nf, *rr = d + nf, *z = rr + nf, *p = z + nf, *q = p + nf;
+    double *zero = q + nf, *full = zero + nf, *yfull = full + s->n_dofs, *work = yfull + s->n_dofs;
+    memset(zero, 0, nf * sizeof(double));
+    int solves = 1;
+    if ((st = sem_system_solve_rest(s, b, x, err)) != SEM_OK) goto done;
+    for (;;) {
+        /* r = b - R x - h^2 (K - K0) x, and its componentwise backward error
+         * max_i |r_i| / (|R| |x| + |h^2 (K - K0) x| + |b|)_i (the second term a lower bound
+         * of |h^2 (K - K0)| |x|, which is not formed) */
+        sem_system_residual_rest(s, b, x, r, sc);
+        stiffness_change_multiply(s, h, x, y, full, yfull, work);
+        double berr = 0;
+        for (size_t i = 0; i < nf; ++i) {
+            r[i] -= y[i];
+            double den = sc[i] + fabs(y[i]) + fabs(b[i]);
+            double e = den > 0 ? fabs(r[i]) / den : (r[i] != 0 ? INFINITY : 0.0);
+            if (!(e <= berr)) berr = e;
+        }
+        if (!isfinite(berr)) break;
+        if (berr <= REST_TOLERANCE) {
+            *solved = 1;
+            break;
+        }
+        if (solves >= REST_MAX_SOLVES) break;
+        /* the correction: A d = r by conjugate gradients preconditioned with R's factor, to
+         * REST_INNER_REDUCTION of |r| (then the exact residual again, above) */
+        memset(d, 0, nf * sizeof(double));
+        memcpy(rr, r, nf * sizeof(double));
+        if ((st = sem_system_solve_rest(s, rr, z, err)) != SEM_OK) goto done;
+        solves++;
+        memcpy(p, z, nf * sizeof(double));
+        double rz = dot(rr, z, nf), r0 = sqrt(dot(r, r, nf)), rn = r0;
+        while (rn > REST_INNER_REDUCTION * r0 && solves < REST_MAX_SOLVES) {
+            /* q = A p = R p + h^2 (K - K0) p */
+            sem_system_residual_rest(s, zero, p, q, NULL);
+            stiffness_change_multiply(s, h, p, y, full, yfull, work);
+            for (size_t i = 0; i < nf; ++i) q[i] = y[i] - q[i];
+            double pq = dot(p, q, nf);
+            if (!(pq > 0)) break;
+            double alpha = rz / pq;
+            for (size_t i = 0; i < nf; ++i) {
+                d[i] += alpha * p[i];
+                rr[i] -= alpha * q[i];
+            }
+            rn = sqrt(dot(rr, rr, nf));
+            if (rn <= REST_INNER_REDUCTION * r0) break;
+            if ((st = sem_system_solve_rest(s, rr, z, err)) != SEM_OK) goto done;
+            solves++;
+            double rz1 = dot(rr, z, nf), beta = rz1 / rz;
+            rz = rz1;
+            for (size_t i = 0; i < nf; ++i) p[i] = z[i] + beta * p[i];
+        }
+        if (!(rn <= REST_INNER_REDUCTION * r0) && solves >= REST_MAX_SOLVES) break;
+        if (!(rn < r0)) break;
+        for (size_t i = 0; i < nf; ++i) x[i] += d[i];
+    }
+done:
+    free(r);
+    return st;
+}
+
 /* (M + h C + h^2 K) v+ = M v + h f(q), q+ = q + h v+ (the paper's step), over the system's
  * vectors (its objects' values one after the other). */
 static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error *err)
@@ -25,18 +156,31 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
     double *rhs = malloc(n * sizeof(double) + 1), *tmp = malloc(n * sizeof(double) + 1);
     double *vp = calloc(n + 1, sizeof(double));
     double *fr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
+    double *xr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
+    size_t wz = 0;
+    for (int k = 0; k < s->n_objects; ++k) {
+        size_t need = (1 + GRADIENT_SHARES) * (size_t)s->objects[k]->n_parts * 3 * s->objects[k]->ma;
+        if (need > wz) wz = need;
+    }
+    double *work = malloc((wz + 1) * sizeof(double));
     sem_status st = SEM_OK;
-    if (!f || !g || !rhs || !tmp || !vp || !fr) {
+    if (!f || !g || !rhs || !tmp || !vp || !fr || !xr || !work) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto done;
     }
+    /* q-space systems without contact form the coefficient-space stiffness first, and its
+     * q-space blocks only when A is factorized (see "Reusing the rest factor") */
+    int lazy = s->n_free > 0 && !s->structured && !sem_contact_active(w->contact) && s->n_couplings == 0 &&
+               !w->def.advanced.refactorize;
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t off = s->dof_offset[k], no = 3 * (size_t)o->n_ctrl;
         double *fk = f + off, *gk = g + off, *rk = rhs + off, *tk = tmp + off, *vk = vp + off;
-        /* the system matrix's values are written as its K blocks are formed */
+        /* otherwise the system's values are written as K's blocks are formed (structured
+         * systems: the matrix's coefficients are recorded) */
         const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
-        if ((st = sem_assemble_elastic(o, o->q, 1, gk, s->n_free > 0 ? &fill : NULL, err)) != SEM_OK)
+        if ((st = sem_assemble_elastic(o, o->q, lazy ? SEM_HESSIAN_POINTS : SEM_HESSIAN_FULL, gk,
+                                       s->n_free > 0 && !lazy ? &fill : NULL, err)) != SEM_OK)
             goto done;
         sem_external_force(o, w->time, fk);
         /* f_total = f_ext - grad V - 2 gamma M_eps q */
@@ -55,19 +199,46 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
             any_pinned = 1;
         }
         if (any_pinned) {
-            sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vk, tk);
+            if (lazy) {
+                /* K from the coefficient space (its q-space blocks are not formed yet) */
+                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, 0, h * b, vk, tk);
+                sem_point_hessian_multiply(o, h * h, 0, vk, tk, work);
+            } else {
+                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vk, tk);
+            }
             for (size_t i = 0; i < no; ++i) rk[i] -= tk[i];
         }
     }
     /* contact: springs and friction into the matrix and the right-hand side */
     if (s->n_free > 0 && (st = sem_contact_linearized(w->contact, s, h, rhs, err)) != SEM_OK) goto done;
     if (s->n_free > 0) {
-        st = sem_system_factorize(s, err);
-        w->last_factor_s += sem_system_factor_seconds(s);
-        w->counters.factorizations++;
-        if (st != SEM_OK) goto done;
         sem_system_gather_free(s, rhs, fr);
-        if ((st = sem_system_solve(s, fr, fr, err)) != SEM_OK) goto done;
+        int solved = 0;
+        if (lazy) {
+            double change = 0;
+            for (int k = 0; k < s->n_objects; ++k) {
+                double c = sem_point_hessian_change(s->objects[k]);
+                if (c > change) change = c;
+            }
+            if (change <= REST_MAX_CHANGE && (st = solve_with_rest(w, s, fr, xr, &solved, err)) != SEM_OK)
+                goto done;
+        }
+        if (solved) {
+            memcpy(fr, xr, 3 * (size_t)s->n_free * sizeof(double));
+        } else {
+            if (lazy)
+                for (int k = 0; k < s->n_objects; ++k) {
+                    sem_object *o = s->objects[k];
+                    const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
+                    sem_assemble_kz_from_points(o);
+                    if ((st = sem_assemble_stiffness_blocks(o, &fill, err)) != SEM_OK) goto done;
+                }
+            st = sem_system_factorize(s, err);
+            w->last_factor_s += sem_system_factor_seconds(s);
+            w->counters.factorizations++;
+            if (st != SEM_OK) goto done;
+            if ((st = sem_system_solve(s, fr, fr, err)) != SEM_OK) goto done;
+        }
         sem_system_scatter_free(s, fr, vp);
     }
     for (size_t i = 0; i < n; ++i)
@@ -88,6 +259,8 @@ done:
     free(tmp);
     free(vp);
     free(fr);
+    free(xr);
+    free(work);
     return st;
 }
 

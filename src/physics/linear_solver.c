@@ -3,6 +3,7 @@
 
 #include <cblas.h>
 #include <lapacke.h>
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -150,6 +151,35 @@ done:
     return SEM_OK;
 }
 
+sem_status sem_linear_solver_clone_pattern(const sem_linear_solver *s, sem_linear_solver **out, sem_error *err)
+{
+    *out = NULL;
+    sem_linear_solver *c = calloc(1, sizeof *c);
+    if (!c) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory creating the solver");
+    size_t nn = (size_t)s->n, nz = s->nnz;
+    c->n = s->n;
+    c->nnz = s->nnz;
+    c->choice = s->choice;
+    cholmod_start(&c->common);
+    c->common.print = 0;
+    c->common.error_handler = NULL;
+    memcpy(c->col_split, s->col_split, sizeof c->col_split);
+    c->perm = malloc((nn + 1) * sizeof(int));
+    c->remap = malloc((nz + 1) * sizeof(int));
+    c->work = malloc((3 * nn + 1) * sizeof(double));
+    c->partial = malloc((RESIDUAL_SHARES * nn + 1) * sizeof(double));
+    c->A = cholmod_copy_sparse(s->A, &c->common);
+    if (!c->perm || !c->remap || !c->work || !c->partial || !c->A) {
+        sem_linear_solver_destroy(c);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a second %d x %d factor", s->n, s->n);
+    }
+    memcpy(c->perm, s->perm, nn * sizeof(int));
+    memcpy(c->remap, s->remap, nz * sizeof(int));
+    memset(c->A->x, 0, nz * sizeof(double));
+    *out = c;
+    return SEM_OK;
+}
+
 void sem_linear_solver_remap(const sem_linear_solver *s, int *positions, size_t count)
 {
     for (size_t k = 0; k < count; ++k)
@@ -264,6 +294,28 @@ static void share_product(const sem_linear_solver *s, int t, const double *x, do
     }
 }
 
+/* The same share of |A| |x| (x given as |x|). */
+static void share_abs_product(const sem_linear_solver *s, int t, const double *ax, double *y)
+{
+    const int *p = s->A->p, *ri = s->A->i;
+    const double *v = s->A->x;
+    memset(y, 0, (size_t)s->n * sizeof(double));
+    for (int c = s->col_split[t]; c < s->col_split[t + 1]; ++c) {
+        double xc = ax[c], acc = 0;
+        int k = p[c], end = p[c + 1];
+        if (k < end && ri[k] == c) {
+            y[c] += fabs(v[k]) * xc;
+            ++k;
+        }
+        for (; k < end; ++k) {
+            double a = fabs(v[k]);
+            y[ri[k]] += a * xc;
+            acc += a * ax[ri[k]];
+        }
+        y[c] += acc;
+    }
+}
+
 /* r = b - A x: the column shares in parallel, each into its own vector, summed in share
  * order. */
 static void residual(sem_linear_solver *s, const double *b, const double *x, double *r)
@@ -280,6 +332,34 @@ static void residual(sem_linear_solver *s, const double *b, const double *x, dou
             r[i] = b[i] - ax;
         }
     }
+}
+
+void sem_linear_solver_residual(sem_linear_solver *s, const double *b, const double *x, double *r,
+                                double *scale)
+{
+    size_t n = (size_t)s->n;
+    double *bp = s->work, *xp = s->work + n, *rp = s->work + 2 * n;
+    for (size_t k = 0; k < n; ++k) {
+        bp[k] = b[s->perm[k]];
+        xp[k] = x[s->perm[k]];
+    }
+    residual(s, bp, xp, rp);
+    for (size_t k = 0; k < n; ++k) r[s->perm[k]] = rp[k];
+    if (!scale) return;
+    /* |A| |x|, in the same shares */
+    for (size_t k = 0; k < n; ++k) xp[k] = fabs(xp[k]);
+#pragma omp parallel
+    {
+#pragma omp for schedule(static)
+        for (int t = 0; t < RESIDUAL_SHARES; ++t) share_abs_product(s, t, xp, s->partial + (size_t)t * n);
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; ++i) {
+            double ax = 0;
+            for (int t = 0; t < RESIDUAL_SHARES; ++t) ax += s->partial[(size_t)t * n + i];
+            rp[i] = ax;
+        }
+    }
+    for (size_t k = 0; k < n; ++k) scale[s->perm[k]] = rp[k];
 }
 
 /* One step of iterative refinement: SEM systems mix the mass matrix with the stiff error
@@ -301,6 +381,20 @@ sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double
         if (st == SEM_OK)
             for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k] + r[k];
     }
+    openblas_set_num_threads(blas_threads);
+    return st;
+}
+
+sem_status sem_linear_solver_solve_plain(sem_linear_solver *s, const double *b, double *x, sem_error *err)
+{
+    size_t n = (size_t)s->n;
+    double *bp = s->work, *xp = s->work + n;
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(SEM_SOLVER_BLAS_THREADS);
+    for (size_t k = 0; k < n; ++k) bp[k] = b[s->perm[k]];
+    sem_status st = solve_once(s, bp, xp, err);
+    if (st == SEM_OK)
+        for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k];
     openblas_set_num_threads(blas_threads);
     return st;
 }

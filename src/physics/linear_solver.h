@@ -19,6 +19,10 @@ typedef struct sem_linear_solver sem_linear_solver;
 sem_status sem_linear_solver_create(int n, const int *col_start, const int *row,
                                     sem_solver_choice choice, sem_linear_solver **out,
                                     sem_error *err);
+/* A second solver of the same pattern and order (its own values and factor): positions
+ * remapped for s are valid for it. */
+sem_status sem_linear_solver_clone_pattern(const sem_linear_solver *s, sem_linear_solver **out,
+                                           sem_error *err);
 void sem_linear_solver_destroy(sem_linear_solver *s);
 /* The solver stores the matrix in its own (fill-reducing) order: translates positions in
  * the pattern given to create (-1 stays -1) into positions of sem_linear_solver_values. */
@@ -29,6 +33,14 @@ sem_status sem_linear_solver_factorize(sem_linear_solver *s, sem_error *err);
 /* x = A^-1 b (x may alias b). */
 sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double *x,
                                    sem_error *err);
+/* x = A^-1 b with the factor alone, without the step of iterative refinement (for callers
+ * that iterate themselves). */
+sem_status sem_linear_solver_solve_plain(sem_linear_solver *s, const double *b, double *x,
+                                         sem_error *err);
+/* r = b - A x with the values of the last factorization (same bits on any thread count). */
+/* With scale, also |A| |x| (for a componentwise backward error). */
+void sem_linear_solver_residual(sem_linear_solver *s, const double *b, const double *x, double *r,
+                                double *scale);
 const char *sem_linear_solver_name(const sem_linear_solver *s);
 double sem_linear_solver_last_factor_seconds(const sem_linear_solver *s);
 /* Non-zeros of the full symmetric matrix as a percentage of n^2. */

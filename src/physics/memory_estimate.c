@@ -33,9 +33,12 @@
  *                   factor: dense n^2 doubles up to SEM_DENSE_MAX_DOFS, else CHOLMOD's
  *                   supernodal factor, estimated as 4 x the matrix's entries (measured fill
  *                   on the Table 1 models: 1.3 - 3.4, with supernode padding) and never more
- *                   than the dense lower triangle. Counted twice: the zero-energy mode check
- *                   factors the free object while the world's own solver is made later, and
- *                   freed memory is not always returned to the system.
+ *                   than the dense lower triangle. Counted three times: the world keeps
+ *                   the rest matrix's factor beside the step's (integrators.c, "Reusing the
+ *                   rest factor"; with its own copy of the values), and the zero-energy mode
+ *                   check factors the free object while the world's own solver is made later
+ *                   (freed memory is not always returned to the system). The q-space path
+ *                   also keeps every quadrature point's 9 x 9 Hessian, now and at rest.
  *   structured      instead of blocks and solver, when the discretization has no q-space
  *                   operators (the structured solver, physics/structured.h): Pi over the
  *                   control points and its reduced copy in V with G (the same size again) and
@@ -173,8 +176,11 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
     double factor = n_dofs <= DENSE_MAX_DOFS ? n_dofs * n_dofs
                                              : (FACTOR_FILL * matrix < dense_lower ? FACTOR_FILL * matrix
                                                                                    : dense_lower);
-    out->solver = matrix * 40 + 2 * factor * BYTES_DOUBLE;
+    out->solver = matrix * (40 + BYTES_DOUBLE) + 3 * factor * BYTES_DOUBLE;
+    /* the q-space path's point Hessians, now and at rest */
+    out->assembly += 162 * n_quad * BYTES_DOUBLE;
     if (sem_csr_nnz(&d->M) == 0 && d->n_ctrl > 0) {
+        out->assembly -= 162 * n_quad * BYTES_DOUBLE;
         /* the structured solver (see the opening comment): no q-space blocks */
         const double r0 = (double)np * m, j_nnz = (double)sem_csr_nnz(&d->J_hat);
         const double ws_nnz = (double)sem_csr_nnz(&d->W_samples);

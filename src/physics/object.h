@@ -110,7 +110,8 @@ typedef struct sem_object {
      * no q-space block (K_blocks, M_blocks, E_blocks, K0_blocks) and no group pair exists */
     int structured;
     struct sem_structured_ops *ops;
-    double *K0z;               /* Kz at rest (Rayleigh damping), structured only */
+    double *K0z;               /* Kz at rest (Rayleigh damping; the rest factor) */
+    double *point_H, *point_H0; /* q-space: per point 9 x 9 d2psi/dF2 now and at rest */
 } sem_object;
 
 /* Control points in group g. */

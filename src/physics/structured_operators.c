@@ -234,68 +234,6 @@ static void dense_multiply(const sem_object *o, const double *D, double c, const
 
 /* y += Kc x for Kc = cK K + cD K0 in the shared basis: z' = pi_shared x, per stored pair
  * (a <= b) out_a += Kc_ab z'_b and out_b += Kc_ab^T z'_a, then pi_shared^T out. */
-static void stiffness_multiply(const sem_object *o, double cK, double cD, const double *x, double *y)
-{
-    int ma = o->ma, n3 = 3 * ma;
-    size_t nz = (size_t)o->n_parts * n3, bs = (size_t)n3 * n3;
-    double *zs = calloc(2 * nz + 1, sizeof(double));
-    if (!zs) return; /* unreachable in practice; the product is then incomplete */
-    double *out = zs + nz;
-#pragma omp parallel for schedule(static) num_threads(o->nthreads)
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = o->d->part_origin[i];
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        for (int k = 0; k < ma; ++k) {
-            const double *row = o->pi_shared[i] + (size_t)k * n;
-            double s0 = 0, s1 = 0, s2 = 0;
-            for (size_t j = 0; j < n; ++j) {
-                const double *xc = x + 3 * (size_t)ctrl[j];
-                s0 += row[j] * xc[0];
-                s1 += row[j] * xc[1];
-                s2 += row[j] * xc[2];
-            }
-            zs[(size_t)i * n3 + 3 * k + 0] = s0;
-            zs[(size_t)i * n3 + 3 * k + 1] = s1;
-            zs[(size_t)i * n3 + 3 * k + 2] = s2;
-        }
-    }
-    /* Kz rows (k, d) = 3k + d, columns (d', k') = d' ma + k'; z' entries 3k + d */
-    for (int pr = 0; pr < o->n_pairs; ++pr) {
-        int a = o->pair_a[pr], b = o->pair_b[pr];
-        if (a > b || o->plist_start[pr + 1] == o->plist_start[pr]) continue;
-        const double *K = o->Kz + (size_t)pr * bs, *K0 = o->K0z + (size_t)pr * bs;
-        const double *za = zs + (size_t)a * n3, *zb = zs + (size_t)b * n3;
-        double *oa = out + (size_t)a * n3, *ob = out + (size_t)b * n3;
-        for (int r = 0; r < n3; ++r)
-            for (int d2 = 0; d2 < 3; ++d2)
-                for (int k2 = 0; k2 < ma; ++k2) {
-                    size_t at = (size_t)r * n3 + (size_t)(d2 * ma + k2);
-                    double v = cK * K[at] + (cD != 0 ? cD * K0[at] : 0);
-                    oa[r] += v * zb[3 * k2 + d2];
-                    if (a != b) ob[3 * k2 + d2] += v * za[r];
-                }
-    }
-#pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
-    for (int g = 0; g < o->n_groups; ++g)
-        for (int i = 0; i < o->n_parts; ++i) {
-            if (o->d->part_origin[i] != g) continue;
-            size_t n = sem_group_size(o, g);
-            const int *ctrl = o->group_ctrl + o->group_start[g];
-            const double *oi = out + (size_t)i * n3;
-            for (int k = 0; k < ma; ++k) {
-                const double *row = o->pi_shared[i] + (size_t)k * n;
-                for (size_t j = 0; j < n; ++j) {
-                    double *yc = y + 3 * (size_t)ctrl[j];
-                    yc[0] += row[j] * oi[3 * k + 0];
-                    yc[1] += row[j] * oi[3 * k + 1];
-                    yc[2] += row[j] * oi[3 * k + 2];
-                }
-            }
-        }
-    free(zs);
-}
-
 void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
                              const double *x, double *y)
 {
@@ -332,7 +270,12 @@ void sem_structured_multiply(const sem_object *o, double cM, double cE, double c
     }
     apply_Pt(o, oz, y);
     free(yz);
-    if (cK != 0 || cD != 0) stiffness_multiply(o, cK, cD, x, y);
+    if (cK != 0 || cD != 0) {
+        double *work = malloc((2 * (size_t)o->n_parts * 3 * o->ma + 1) * sizeof(double));
+        if (!work) return; /* unreachable in practice; the product is then incomplete */
+        sem_stiffness_z_multiply(o, cK, o->Kz, cD, cD != 0 ? o->K0z : NULL, x, y, work);
+        free(work);
+    }
 }
 
 void sem_structured_own_basis(const sem_object *o, int a, int b, const double *Kz_ab, int transpose,

@@ -50,6 +50,10 @@ typedef struct sem_system {
     size_t n_dofs;             /* 3 x all control points */
     int **map;                 /* per object: per K block entry, position in the values or -1 */
     sem_linear_solver *solver; /* NULL when nothing is free (or structured) */
+    /* the rest matrix's factor, kept for the run (integrators.c, "Reusing the rest
+     * factor"): same pattern as solver, values cM M + cE 2 gamma M_eps + cD K0 */
+    sem_linear_solver *rest;
+    double rest_coef[3];
     int structured;            /* the objects' own structured solvers (structured.h) instead */
     struct sem_structured_solver **ssolver; /* per object, NULL when it has nothing free */
     double factor_s;           /* seconds of the last factorization (structured) */
@@ -96,6 +100,18 @@ sem_status sem_system_factorize(sem_system *s, sem_error *err);
 double sem_system_factor_seconds(const sem_system *s);
 /* x = A^-1 b over the free dofs (x may alias b). */
 sem_status sem_system_solve(sem_system *s, const double *b, double *x, sem_error *err);
+
+/* The factor of the rest matrix cM M + cE 2 gamma_k M_eps + cD K0 (q-space systems): made
+ * the first time, and again only when the coefficients change; *factored says whether this
+ * call factored. */
+sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, int *factored,
+                                    sem_error *err);
+double sem_system_rest_factor_seconds(const sem_system *s);
+/* x = R^-1 b with the rest factor alone (no refinement; the caller iterates). */
+sem_status sem_system_solve_rest(sem_system *s, const double *b, double *x, sem_error *err);
+
+/* r = b - R x over the free dofs, R the rest matrix. */
+void sem_system_residual_rest(sem_system *s, const double *b, const double *x, double *r, double *scale);
 
 /* Free dofs of a full vector (the objects' 3 n_ctrl values at dof_offset) and back. */
 void sem_system_gather_free(const sem_system *s, const double *full, double *free_values);

@@ -300,6 +300,7 @@ void sem_system_destroy(sem_system *s)
         for (int k = 0; k < s->n_objects; ++k) sem_structured_solver_destroy(s->ssolver[k]);
     free(s->ssolver);
     sem_linear_solver_destroy(s->solver);
+    sem_linear_solver_destroy(s->rest);
     free(s->objects);
     free(s->free_offset);
     free(s->dof_offset);
@@ -351,6 +352,47 @@ void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD)
 #pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
         for (int g = 0; g < o->n_gpairs; ++g) sem_system_fill_gpair(s, k, g, c, val);
     }
+}
+
+sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, int *factored,
+                                    sem_error *err)
+{
+    *factored = 0;
+    if (s->rest && s->rest_coef[0] == cM && s->rest_coef[1] == cE && s->rest_coef[2] == cD) return SEM_OK;
+    if (!s->rest) {
+        sem_status st = sem_linear_solver_clone_pattern(s->solver, &s->rest, err);
+        if (st != SEM_OK) return st;
+    }
+    double *val = sem_linear_solver_values(s->rest);
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        const double c[4] = {cM, cE * o->gamma, 0.0, cD};
+#pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
+        for (int g = 0; g < o->n_gpairs; ++g) sem_system_fill_gpair(s, k, g, c, val);
+    }
+    s->rest_coef[0] = -1; /* not valid until factored */
+    sem_status st = sem_linear_solver_factorize(s->rest, err);
+    if (st != SEM_OK) return st;
+    s->rest_coef[0] = cM;
+    s->rest_coef[1] = cE;
+    s->rest_coef[2] = cD;
+    *factored = 1;
+    return SEM_OK;
+}
+
+double sem_system_rest_factor_seconds(const sem_system *s)
+{
+    return s->rest ? sem_linear_solver_last_factor_seconds(s->rest) : 0.0;
+}
+
+sem_status sem_system_solve_rest(sem_system *s, const double *b, double *x, sem_error *err)
+{
+    return sem_linear_solver_solve_plain(s->rest, b, x, err);
+}
+
+void sem_system_residual_rest(sem_system *s, const double *b, const double *x, double *r, double *scale)
+{
+    sem_linear_solver_residual(s->rest, b, x, r, scale);
 }
 
 double *sem_system_values(sem_system *s)

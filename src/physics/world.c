@@ -130,6 +130,8 @@ static void object_destroy(sem_object *o)
     free(o->me_E);
     free(o->K0_blocks);
     free(o->K0z);
+    free(o->point_H);
+    free(o->point_H0);
     sem_structured_free(o);
     free(o->f_gravity);
     free(o->pinned);
@@ -290,10 +292,24 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     if ((st = sem_loads_gravity(o, w->def.gravity, err)) != SEM_OK) goto fail;
     /* rest stiffness for Rayleigh damping */
     if ((st = sem_assemble_elastic(o, o->q0, 1, NULL, NULL, err)) != SEM_OK) goto fail;
-    if (o->structured)
-        memcpy(o->K0z, o->Kz, (size_t)o->n_pairs * 9 * o->ma * o->ma * sizeof(double));
-    else
+    /* (the q-space solvers use K0z too: the rest matrix they may reuse, integrators.c) */
+    if (!o->K0z && !(o->K0z = malloc(((size_t)o->n_pairs * 9 * o->ma * o->ma + 1) * sizeof(double)))) {
+        sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    memcpy(o->K0z, o->Kz, (size_t)o->n_pairs * 9 * o->ma * o->ma * sizeof(double));
+    if (!o->structured) {
         memcpy(o->K0_blocks, o->K_blocks, 9 * o->gpair_offset[o->n_gpairs] * sizeof(double));
+        /* the point Hessians at rest (the linearly implicit step's products, integrators.c) */
+        o->point_H = malloc(81 * (size_t)o->n_quad * sizeof(double) + 1);
+        o->point_H0 = malloc(81 * (size_t)o->n_quad * sizeof(double) + 1);
+        if (!o->point_H || !o->point_H0) {
+            sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        if ((st = sem_assemble_elastic(o, o->q0, SEM_HESSIAN_POINTS, NULL, NULL, err)) != SEM_OK) goto fail;
+        memcpy(o->point_H0, o->point_H, 81 * (size_t)o->n_quad * sizeof(double));
+    }
     /* initial velocity: v = v0 + omega x (x - com) is affine, so exact on control points */
     {
         double com[3] = {0, 0, 0};
