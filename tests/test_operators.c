@@ -304,7 +304,7 @@ static void test_hand_made(int order)
     char what[64];
     snprintf(what, sizeof what, "hand-made cube order %d", order);
     sem_preprocess_options o = sem_default_preprocess_options();
-    o.q_space_operators = 1; /* this file checks Grad, Gamma_samples, M and M_eps */
+    o.q_space_operators = 2; /* this file checks Grad, Gamma_samples, M and M_eps */
     o.order = order;
     sem_error err;
 
@@ -362,7 +362,7 @@ static void test_pipeline(const char *what, sem_model *model, int order, double 
                           double volume_tol, int affine_exact)
 {
     sem_preprocess_options o = sem_default_preprocess_options();
-    o.q_space_operators = 1; /* this file checks Grad, Gamma_samples, M and M_eps */
+    o.q_space_operators = 2; /* this file checks Grad, Gamma_samples, M and M_eps */
     o.order = order;
     o.rays[0] = o.rays[1] = 8;
     o.points_per_interval = 4;

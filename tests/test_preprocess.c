@@ -237,6 +237,7 @@ static void test_save_load(void)
 {
     sem_model *box = make_box(1, 2, 1);
     sem_preprocess_options o = fast_options();
+    o.q_space_operators = 2; /* every operator, so that every one is saved and loaded */
     sem_discretization *d = NULL, *e = NULL;
     sem_error err;
     CHECK(sem_preprocess(box, &o, &d, &err) == SEM_OK, "%s", err.message);

@@ -60,11 +60,12 @@ typedef struct sem_preprocess_options {
     double youngs_modulus;   /* for the default gamma; default 1e6 */
     int tessellation;        /* triangle grid cells per knot span per direction; default 16 */
     int threads;             /* 0: OpenMP default */
-    int q_space_operators;   /* 1: also form the control-point-space operators Grad,
-                                Gamma_samples, M and M_eps (the q-space solvers and the operator
-                                tests need them; dense blocks for most models); 0: Gamma only,
-                                which is all the structured solver needs; -1 (default): 1 when
-                                the default world would not use the structured solver
+    int q_space_operators;   /* 1: also form the control-point-space operators
+                                Gamma_samples, M and M_eps (the q-space solvers need them; dense
+                                blocks for most models); 2: and Grad (no solver reads it: for
+                                inspection and the operator tests); 0: Gamma only, which is all
+                                the structured solver needs; -1 (default): 1 when the default
+                                world would not use the structured solver
                                 (sem_world_def_structured), else 0 */
 } sem_preprocess_options;
 
@@ -128,7 +129,7 @@ typedef struct sem_discretization {
     sem_csr Gamma;         /* n_quad x n_ctrl: x(X_p) = Gamma Q (Eq. 12) */
     sem_csr Grad;          /* 3 n_quad x n_ctrl: F_p[d][e] = (Grad[3p+e] . Q[:,d]) (Eq. 15) */
     sem_csr Gamma_samples; /* n_samples x n_ctrl: SEM map at the boundary samples */
-    /* Grad, Gamma_samples, M, M_eps: formed with options.q_space_operators only, else
+    /* Gamma_samples, M, M_eps: formed with options.q_space_operators >= 1, Grad with 2, else
      * empty (their rows, no entries) */
     sem_csr M;             /* n_ctrl x n_ctrl, unit density: sum vol Gamma^T Gamma (Eq. 14) */
     sem_csr M_eps;         /* n_ctrl x n_ctrl: sum area (Gamma_s - J_s)^T (Gamma_s - J_s) (Eq. 16),

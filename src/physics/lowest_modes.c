@@ -74,7 +74,7 @@ static int m_orthonormalize(const sem_mode_operator *op, size_t n, int b, double
     return kept;
 }
 
-int sem_lowest_modes(const sem_mode_operator *op, size_t n, int block, int want, int max_iter,
+int sem_lowest_modes(const sem_mode_operator *op, size_t n, int block, int want, int max_iter, double coarse_above,
                      const double *rigid, int n_rigid, double *values, double *vectors)
 {
     if (!op || n == 0 || block < 1 || want < 1 || want > block) return -1;
@@ -138,8 +138,11 @@ int sem_lowest_modes(const sem_mode_operator *op, size_t n, int block, int want,
             if (op->mult_M(op->user, X + (size_t)j * n, MX + (size_t)j * n) != 0) goto done;
         converged = 1;
         double scale = fabs(w[b - 1]) > 0 ? fabs(w[b - 1]) : 1.0;
-        for (int k = 0; k < want; ++k)
-            if (!(fabs(w[k] - prev[k]) <= 1e-10 * scale + 1e-8 * fabs(w[k]))) converged = 0;
+        for (int k = 0; k < want; ++k) {
+            double change = fabs(w[k] - prev[k]);
+            int coarse = coarse_above > 0 && w[k] > coarse_above && change <= SEM_MODES_COARSE * w[k];
+            if (!(change <= 1e-10 * scale + 1e-8 * fabs(w[k])) && !coarse) converged = 0;
+        }
         for (int k = 0; k < b; ++k) prev[k] = w[k];
     }
     for (int k = 0; k < want; ++k) values[k] = w[k];

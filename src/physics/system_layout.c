@@ -141,19 +141,33 @@ static sem_status build_pattern(sem_system *s, sem_solver_choice choice, sem_err
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto done;
     }
-    for (int c = 0; c < nf; ++c) {
-        int a = count[c], b = count[c + 1];
-        /* insertion sort is fine for short columns; use counting by row otherwise */
-        for (int k = a; k < b; ++k) perm[k] = k;
-        for (int k = a + 1; k < b; ++k) {
-            int x = perm[k], j = k - 1;
-            while (j >= a && rows[perm[j]] > rows[x]) {
-                perm[j + 1] = perm[j];
-                --j;
-            }
-            perm[j + 1] = x;
+    /* rows sorted within every column in O(nnz), by a counting sort on the row: entries are
+     * bucketed by row (columns in increasing order within a bucket), then the buckets are
+     * dealt out to their columns in row order (perm holds each entry's column, sorted the
+     * bucketed entries). A column of the 30 % dense system of an 11,439-dof CAD part holds
+     * ~3,400 rows, where an insertion sort per column took most of a minute. */
+    {
+        int *rstart = calloc((size_t)nf + 2, sizeof(int)), *cpos = malloc(((size_t)nf + 1) * sizeof(int));
+        if (!rstart || !cpos) {
+            free(rstart);
+            free(cpos);
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+            goto done;
         }
-        for (int k = a; k < b; ++k) inv[perm[k]] = k;
+        for (int k = 0; k < count[nf]; ++k) rstart[rows[k] + 1]++;
+        for (int r = 0; r < nf; ++r) rstart[r + 1] += rstart[r];
+        for (int c = 0; c < nf; ++c)
+            for (int k = count[c]; k < count[c + 1]; ++k) {
+                perm[k] = c;
+                sorted[rstart[rows[k]]++] = k;
+            }
+        memcpy(cpos, count, (size_t)nf * sizeof(int));
+        for (int j = 0; j < count[nf]; ++j) {
+            int k = sorted[j];
+            inv[k] = cpos[perm[k]]++;
+        }
+        free(rstart);
+        free(cpos);
     }
     for (int k = 0; k < count[nf]; ++k) sorted[inv[k]] = rows[k];
     for (int k = 0; k < s->n_objects; ++k) {

@@ -481,10 +481,17 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
         d->stiffness_nnz_percent = group_pattern_percent(d);
         goto gamma;
     }
-    /* Eq. 15 */
-    TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 0, &Gd));
+    /* Eq. 15: the gradient rows over control points only when asked for (level 2): no
+     * solver reads them (the stiffness is assembled in coefficient space, assembly.h), and
+     * they are the largest operator (3 rows per point: 1.7 GB of a 11,439-dof CAD part's
+     * 2.4 GB) */
+    if (o->q_space_operators >= 2) {
+        TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 0, &Gd));
+        TRY(csr_product(&Gd, &d->Pi, &d->Grad, 0, NULL));
+    } else {
+        TRY(empty_rows(&d->Grad, 3 * d->n_quad, d->n_ctrl));
+    }
     TRY(build_poly_rows(d, &d->W_samples, d->sample_X, 1, 0, &Gs));
-    TRY(csr_product(&Gd, &d->Pi, &d->Grad, 0, NULL));
     TRY(csr_product(&Gs, &d->Pi, &d->Gamma_samples, 0, NULL));
 
     /* Eq. 14: M = Pi^T (G^T V G) Pi, unit density */

@@ -193,7 +193,7 @@ static void hash_loop(fnv *f, const sem_trim_loop *l)
 
 int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o)
 {
-    if (o->q_space_operators >= 0) return o->q_space_operators != 0;
+    if (o->q_space_operators >= 0) return o->q_space_operators > 2 ? 2 : o->q_space_operators;
     /* the rule of SEM_SOLVER_AUTO for a default world (sem_world_def_structured) */
     size_t n_ctrl = model ? sem_model_control_points(model) : 0;
     size_t n_parts = model ? (size_t)model->n_parts : 0, m = o->order == 1 ? 4 : 10;
