@@ -548,10 +548,12 @@ static void count_lines(void *user, int level, const char *message)
  * x = 0, sagging under gravity (E 1e8: 1.6 cm in 0.3 s): the rest factor serves every step
  * (one factorization in all). A box spinning at 10 rad/s: its stiffness rotates away from the
  * rest one, and once the change passes the threshold the step factorizes again. Both give the
- * states of the factorizing step to round-off (1e-10 of the motion here). */
+ * states of the factorizing step to round-off (1e-10 of the motion here), with CHOLMOD and with
+ * the structured solver (whose rest factor preconditions its conjugate gradients). */
 static void test_rest_factor(void)
 {
-    for (int spin = 0; spin < 2; ++spin) {
+    for (int run = 0; run < 4; ++run) {
+        int spin = run % 2, structured = run / 2;
         double *q[2] = {NULL, NULL}, *q0 = NULL;
         unsigned char *pin = NULL;
         long factorizations[2] = {0, 0};
@@ -575,7 +577,7 @@ static void test_rest_factor(void)
             wd.gravity[2] = spin ? 0.0 : -9.81;
             wd.dt = 0.01;
             wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
-            wd.solver = SEM_SOLVER_SPARSE;
+            wd.solver = structured ? SEM_SOLVER_STRUCTURED : SEM_SOLVER_SPARSE;
             wd.advanced.refactorize = refactorize;
             s.world = sem_world_create(&wd, &err);
             sem_object_def od = sem_default_object_def();
@@ -603,9 +605,10 @@ static void test_rest_factor(void)
                 motion = fmax(motion, fabs(q[1][i] - q0[i]));
                 diff = fmax(diff, fabs(q[0][i] - q[1][i]));
             }
-            printf("rest factor, %s: motion %.3g m, rest factor vs factorizing %.3g m, %ld factorizations "
+            printf("rest factor, %s, %s: motion %.3g m, rest factor vs factorizing %.3g m, %ld factorizations "
                    "(%ld factorizing every step)\n",
-                   spin ? "spinning box" : "cantilever", motion, diff, factorizations[0], factorizations[1]);
+                   spin ? "spinning box" : "cantilever", structured ? "structured" : "cholmod", motion, diff,
+                   factorizations[0], factorizations[1]);
             CHECK(motion > (spin ? 0.5 : 1e-3) && motion < (spin ? 3.0 : 0.05), "spin %d: motion %g m", spin, motion);
             CHECK(diff <= 1e-10 * motion, "spin %d: rest factor vs factorizing: %g m of %g m", spin, diff, motion);
             CHECK(factorizations[1] == steps, "spin %d: %ld factorizations", spin, factorizations[1]);

@@ -31,13 +31,35 @@
  * Whether a step tries R is decided from the state alone (the relative change of the point
  * Hessians from rest, at most REST_MAX_CHANGE), and R is a function of the scene, not of the
  * run's history: a resumed run takes the same path step by step and gives the same bits
- * (docs/scenes.md, "Interrupted runs"). Systems with contact (point terms in the matrix)
- * and structured systems (their own factorization, structured.h) always factorize.
+ * (docs/scenes.md, "Interrupted runs"). Structured systems keep their rest Schur factor
+ * beside the current one and use it to precondition their conjugate gradients (structured.h;
+ * change measured on Kz). Systems with contact (point terms in the matrix) always factorize.
  */
 #define REST_MAX_CHANGE 0.5
 #define REST_TOLERANCE 1e-14
 #define REST_INNER_REDUCTION 1e-6
 #define REST_MAX_SOLVES 24
+/* structured systems: CG iterations with the rest factor, and the largest coefficient-space
+ * factor (its order) that gets a second, rest copy */
+#define REST_STRUCTURED_ITERATIONS 20
+#define REST_STRUCTURED_MAX_ORDER 2000
+
+/* |Kz - K0z|_F / |K0z|_F over the object's part pairs (structured objects keep Kz). */
+static double kz_change(const sem_object *o)
+{
+    size_t bs = 9 * (size_t)o->ma * o->ma;
+    double dn = 0, rn = 0;
+    for (int pr = 0; pr < o->n_pairs; ++pr) {
+        if (o->pair_a[pr] > o->pair_b[pr] || o->plist_start[pr + 1] == o->plist_start[pr]) continue;
+        const double *K = o->Kz + pr * bs, *K0 = o->K0z + pr * bs;
+        for (size_t i = 0; i < bs; ++i) {
+            double d = K[i] - K0[i];
+            dn += d * d;
+            rn += K0[i] * K0[i];
+        }
+    }
+    return rn > 0 ? sqrt(dn / rn) : (dn > 0 ? INFINITY : 0.0);
+}
 
 /* In index order: the same bits on any thread count. */
 static double dot(const double *a, const double *b, size_t n)
@@ -222,6 +244,20 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
             }
             if (change <= REST_MAX_CHANGE && (st = solve_with_rest(w, s, fr, xr, &solved, err)) != SEM_OK)
                 goto done;
+        }
+        if (s->structured && !sem_contact_active(w->contact) && s->n_couplings == 0 &&
+            !w->def.advanced.refactorize) {
+            double change = 0;
+            for (int k = 0; k < s->n_objects; ++k) change = fmax(change, kz_change(s->objects[k]));
+            long nf = 0;
+            double fs = 0;
+            if (change <= REST_MAX_CHANGE) {
+                st = sem_system_solve_structured_rest(s, REST_STRUCTURED_MAX_ORDER, REST_STRUCTURED_ITERATIONS, fr, xr,
+                                                      &solved, &nf, &fs, err);
+                w->counters.factorizations += nf;
+                w->last_factor_s += fs;
+                if (st != SEM_OK) goto done;
+            }
         }
         if (solved) {
             memcpy(fr, xr, 3 * (size_t)s->n_free * sizeof(double));

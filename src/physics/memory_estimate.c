@@ -187,6 +187,7 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
         out->blocks = 0;
         out->solver = 5 * pi_dense * m * (BYTES_DOUBLE + BYTES_INT) + (j_nnz + ws_nnz * m) * (BYTES_DOUBLE + BYTES_INT) +
                       10 * 9 * r0 * r0 * BYTES_DOUBLE + 8 * j_nnz * (BYTES_DOUBLE + BYTES_INT) +
+                      (3 * r0 <= 2000 ? 9 * r0 * r0 * BYTES_DOUBLE : 0) + /* the rest factor */
                       2 * 128 * (double)d->n_ctrl * BYTES_DOUBLE;
     }
     double run = out->blocks + out->assembly + out->solver;

@@ -83,5 +83,16 @@ sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *
 sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b, double *x,
                                        sem_error *err);
 double sem_structured_solver_factor_seconds(const sem_structured_solver *s);
+/* The factor of the rest matrix: the current coefficients with K0 in place of K (made once,
+ * again when the coefficients change; *factored says whether this call factored). The
+ * current factor is kept apart from it. */
+/* The order of its coefficient-space factor (3 k). */
+int sem_structured_solver_coefficients(const sem_structured_solver *s);
+sem_status sem_structured_solver_factorize_rest(sem_structured_solver *s, int *factored, sem_error *err);
+/* x = A^-1 b for the current matrix by conjugate gradients preconditioned with the rest
+ * factor, at most max_it iterations; *solved = 0 when that did not reach the solver's
+ * tolerance (x is then undefined; not an error). */
+sem_status sem_structured_solver_solve_rest(sem_structured_solver *s, const double *b, double *x, int max_it,
+                                            int *solved, sem_error *err);
 
 #endif

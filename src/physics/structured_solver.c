@@ -94,6 +94,12 @@ struct sem_structured_solver {
     double **Ep_blk; /* per group: its rows x its columns of Ep, row-major */
     double *gscratch; /* per group pair products (see factorize) */
     double shift;   /* the diagonal shift the last factorization needed (0: none) */
+    /* the rest matrix's factor (integrators.c, "Reusing the rest factor"): C of the
+     * coefficients rest_coef with K0 in place of K; rest_ok once made */
+    double *C_rest;
+    double rest_coef[4];
+    int rest_ok;
+    const double *Cf; /* the factor the solves use: C, or C_rest while solving with it */
     double coef[4];
     double last_factor_s;
     double *work;
@@ -118,6 +124,7 @@ void sem_structured_solver_destroy(sem_structured_solver *s)
     free(s->Bp);
     free(s->Hc);
     free(s->C);
+    free(s->C_rest);
     free(s->H);
     free(s->Zt);
     if (s->Ep_blk)
@@ -613,6 +620,7 @@ sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **o
         }
         s->gscratch = malloc((rmax * rmax + rmax * kmax + kmax * kmax + 1) * sizeof(double));
         s->work = malloc((6 * (size_t)o->n_ctrl + 12 * (size_t)s->r + 1) * sizeof(double));
+        s->Cf = s->C;
         if (!s->C || !s->H || !s->Zt || !s->gscratch || !s->work)
             st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a %zu x %zu coefficient matrix", N, N);
     }
@@ -771,7 +779,7 @@ static void capacitance_solve(sem_structured_solver *s, double *v)
     cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, k, 3, k, -1.0, s->Bp, k, a1, 3, 1.0, a2, 3);
     lapack_int info = 0, one = 1, N = 3 * k;
     char uplo = 'L';
-    if (N > 0) LAPACK_dpotrs(&uplo, &N, &one, s->C, &N, a2, &N, &info);
+    if (N > 0) LAPACK_dpotrs(&uplo, &N, &one, (double *)s->Cf, &N, a2, &N, &info);
     for (int q = 0; q < 3 * k; ++q) a2[q] = -a2[q];
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, k, 3, k, -1.0, s->Bp, k, a2, 3, 1.0, a1, 3);
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, r, 3, k, 1.0, s->T, k, a1, 3, 0.0, v1, 3);
@@ -858,9 +866,12 @@ static double dot(const double *a, const double *b, size_t n)
     return (s0 + s1) + (s2 + s3);
 }
 
-sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b, double *x,
-                                       sem_error *err)
+/* CG on the exact A preconditioned by the Woodbury solve with the factor Cf, at most max_it
+ * iterations; *converged says whether it reached CG_TOLERANCE (soft: not an error). */
+static sem_status cg_solve(sem_structured_solver *s, const double *b, double *x, int max_it, int *converged,
+                           sem_error *err)
 {
+    *converged = 0;
     size_t n3 = 3 * (size_t)s->n;
     if (n3 == 0) return SEM_OK;
     /* b, the residual, the preconditioned residual, the direction and A p */
@@ -873,19 +884,26 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
     double bnorm = sqrt(dot(bb, bb, n3));
     sem_status st = SEM_OK;
     woodbury(s, bb, x);
-    if (bnorm == 0) goto done;
+    if (bnorm == 0) {
+        *converged = 1;
+        goto done;
+    }
     apply_A(s, x, q);
     for (size_t i = 0; i < n3; ++i) rr[i] = bb[i] - q[i];
     double rnorm = sqrt(dot(rr, rr, n3));
-    if (rnorm <= CG_TOLERANCE * bnorm) goto done;
+    if (rnorm <= CG_TOLERANCE * bnorm) {
+        *converged = 1;
+        goto done;
+    }
     woodbury(s, rr, zz);
     memcpy(p, zz, n3 * sizeof(double));
     double rz = dot(rr, zz, n3);
     int it;
-    for (it = 0; it < CG_MAX_ITERATIONS; ++it) {
+    for (it = 0; it < max_it; ++it) {
         apply_A(s, p, q);
         double pq = dot(p, q, n3);
         if (!(pq > 0)) {
+            if (max_it != CG_MAX_ITERATIONS) goto done; /* the rest factor's try: soft */
             st = sem_error_set(err, SEM_ERR_NUMERIC,
                                "system matrix is not positive definite (a direction of non-positive "
                                "curvature): the state may have exploded or the object is not held");
@@ -897,14 +915,18 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
             rr[i] -= alpha * q[i];
         }
         rnorm = sqrt(dot(rr, rr, n3));
-        if (rnorm <= CG_TOLERANCE * bnorm) break;
+        if (rnorm <= CG_TOLERANCE * bnorm) {
+            *converged = 1;
+            break;
+        }
         woodbury(s, rr, zz);
         double rz1 = dot(rr, zz, n3);
         double beta = rz1 / rz;
         rz = rz1;
         for (size_t i = 0; i < n3; ++i) p[i] = zz[i] + beta * p[i];
     }
-    if (!(rnorm <= CG_FAIL * bnorm))
+    if (!*converged && rnorm <= CG_FAIL * bnorm && max_it == CG_MAX_ITERATIONS) *converged = 1;
+    if (!*converged && max_it == CG_MAX_ITERATIONS)
         st = sem_error_set(err, SEM_ERR_NUMERIC,
                            "the structured solve did not converge (relative residual %.2g after %d "
                            "refinement iterations)",
@@ -913,4 +935,54 @@ done:
     openblas_set_num_threads(blas_threads);
     free(bb);
     return st;
+}
+
+sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b, double *x,
+                                       sem_error *err)
+{
+    int converged = 0;
+    s->Cf = s->C;
+    return cg_solve(s, b, x, CG_MAX_ITERATIONS, &converged, err);
+}
+
+sem_status sem_structured_solver_factorize_rest(sem_structured_solver *s, int *factored, sem_error *err)
+{
+    const double rc[4] = {s->coef[0], s->coef[1], 0.0, s->coef[2] + s->coef[3]};
+    *factored = 0;
+    if (s->rest_ok && memcmp(rc, s->rest_coef, sizeof rc) == 0) return SEM_OK;
+    s->rest_ok = 0;
+    size_t N = 3 * (size_t)s->k;
+    if (!s->C_rest && !(s->C_rest = malloc((N * N + 1) * sizeof(double))))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the rest factor");
+    /* factorize with K0 in place of K, then keep that factor apart */
+    double now[4];
+    memcpy(now, s->coef, sizeof now);
+    memcpy(s->coef, rc, sizeof rc);
+    sem_status st = sem_structured_solver_factorize(s, err);
+    memcpy(s->coef, now, sizeof now);
+    if (st != SEM_OK) return st;
+    double *t = s->C_rest;
+    s->C_rest = s->C;
+    s->C = t;
+    s->Cf = s->C;
+    memcpy(s->rest_coef, rc, sizeof rc);
+    s->rest_ok = 1;
+    *factored = 1;
+    return SEM_OK;
+}
+
+sem_status sem_structured_solver_solve_rest(sem_structured_solver *s, const double *b, double *x, int max_it,
+                                            int *solved, sem_error *err)
+{
+    *solved = 0;
+    if (!s->rest_ok) return SEM_OK;
+    s->Cf = s->C_rest;
+    sem_status st = cg_solve(s, b, x, max_it, solved, err);
+    s->Cf = s->C;
+    return st;
+}
+
+int sem_structured_solver_coefficients(const sem_structured_solver *s)
+{
+    return 3 * s->k;
 }

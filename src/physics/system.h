@@ -110,6 +110,13 @@ double sem_system_rest_factor_seconds(const sem_system *s);
 /* x = R^-1 b with the rest factor alone (no refinement; the caller iterates). */
 sem_status sem_system_solve_rest(sem_system *s, const double *b, double *x, sem_error *err);
 
+/* Structured systems: x = A^-1 b by each object's conjugate gradients preconditioned with its
+ * rest factor (made the first time; counted into *factorizations and *factor_s), at most
+ * max_it iterations; nothing is tried when a coefficient-space factor is larger than
+ * max_order (the rest factor would double its memory). *solved = 0: not converged (x
+ * undefined, not an error). */
+sem_status sem_system_solve_structured_rest(sem_system *s, int max_order, int max_it, const double *b, double *x,
+                                           int *solved, long *factorizations, double *factor_s, sem_error *err);
 /* r = b - R x over the free dofs, R the rest matrix. */
 void sem_system_residual_rest(sem_system *s, const double *b, const double *x, double *r, double *scale);
 

@@ -409,6 +409,31 @@ void sem_system_residual_rest(sem_system *s, const double *b, const double *x, d
     sem_linear_solver_residual(s->rest, b, x, r, scale);
 }
 
+sem_status sem_system_solve_structured_rest(sem_system *s, int max_order, int max_it, const double *b, double *x,
+                                           int *solved, long *factorizations, double *factor_s, sem_error *err)
+{
+    *solved = 0;
+    for (int k = 0; k < s->n_objects; ++k)
+        if (s->ssolver[k] && sem_structured_solver_coefficients(s->ssolver[k]) > max_order) return SEM_OK;
+    for (int k = 0; k < s->n_objects; ++k) {
+        if (!s->ssolver[k]) continue;
+        int factored = 0;
+        sem_status st = sem_structured_solver_factorize_rest(s->ssolver[k], &factored, err);
+        if (factored) {
+            (*factorizations)++;
+            *factor_s += sem_structured_solver_factor_seconds(s->ssolver[k]);
+        }
+        if (st != SEM_OK) return st;
+        size_t off = 3 * (size_t)s->free_offset[k];
+        int ok = 0;
+        if ((st = sem_structured_solver_solve_rest(s->ssolver[k], b + off, x + off, max_it, &ok, err)) != SEM_OK)
+            return st;
+        if (!ok) return SEM_OK;
+    }
+    *solved = 1;
+    return SEM_OK;
+}
+
 double *sem_system_values(sem_system *s)
 {
     return s->solver ? sem_linear_solver_values(s->solver) : NULL;
