@@ -62,6 +62,17 @@ static double kz_change(const sem_object *o)
     return rn > 0 ? sqrt(dn / rn) : (dn > 0 ? INFINITY : 0.0);
 }
 
+/* Doubles of work space sem_point_hessian_multiply needs for the largest object. */
+static size_t point_work_size(const sem_system *s)
+{
+    size_t wz = 0;
+    for (int k = 0; k < s->n_objects; ++k) {
+        size_t need = (1 + GRADIENT_SHARES) * (size_t)s->objects[k]->n_parts * 3 * s->objects[k]->ma;
+        if (need > wz) wz = need;
+    }
+    return wz;
+}
+
 /* In index order: the same bits on any thread count. */
 static double dot(const double *a, const double *b, size_t n)
 {
@@ -100,11 +111,7 @@ static sem_status solve_with_rest(sem_world *w, sem_system *s, const double *b, 
         w->counters.factorizations++;
     }
     if (st != SEM_OK) return st;
-    size_t wz = 0;
-    for (int k = 0; k < s->n_objects; ++k) {
-        size_t need = (1 + GRADIENT_SHARES) * (size_t)s->objects[k]->n_parts * 3 * s->objects[k]->ma;
-        if (need > wz) wz = need;
-    }
+    size_t wz = point_work_size(s);
     double *r = malloc((9 * nf + 2 * s->n_dofs + wz + 1) * sizeof(double));
     if (!r) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     double *y = r + nf, *sc = y + nf, *d = sc + nf, *rr = d + nf, *z = rr + nf, *p = z + nf, *q = p + nf;
@@ -180,11 +187,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
     double *vp = calloc(n + 1, sizeof(double));
     double *fr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
     double *xr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
-    size_t wz = 0;
-    for (int k = 0; k < s->n_objects; ++k) {
-        size_t need = (1 + GRADIENT_SHARES) * (size_t)s->objects[k]->n_parts * 3 * s->objects[k]->ma;
-        if (need > wz) wz = need;
-    }
+    size_t wz = point_work_size(s);
     double *work = malloc((wz + 1) * sizeof(double));
     sem_status st = SEM_OK;
     if (!f || !g || !rhs || !tmp || !vp || !fr || !xr || !work) {

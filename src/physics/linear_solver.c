@@ -316,22 +316,32 @@ static void share_abs_product(const sem_linear_solver *s, int t, const double *a
     }
 }
 
-/* r = b - A x: the column shares in parallel, each into its own vector, summed in share
- * order. */
-static void residual(sem_linear_solver *s, const double *b, const double *x, double *r)
+/* The column shares in parallel, each into its own vector, summed in share order:
+ * out = b - A x, or |A| x when absolute (x given as |x|, b NULL). */
+static void share_sum(sem_linear_solver *s, int absolute, const double *b, const double *x, double *out)
 {
     size_t n = (size_t)s->n;
 #pragma omp parallel
     {
 #pragma omp for schedule(static)
-        for (int t = 0; t < RESIDUAL_SHARES; ++t) share_product(s, t, x, s->partial + (size_t)t * n);
+        for (int t = 0; t < RESIDUAL_SHARES; ++t) {
+            if (absolute)
+                share_abs_product(s, t, x, s->partial + (size_t)t * n);
+            else
+                share_product(s, t, x, s->partial + (size_t)t * n);
+        }
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; ++i) {
             double ax = 0;
             for (int t = 0; t < RESIDUAL_SHARES; ++t) ax += s->partial[(size_t)t * n + i];
-            r[i] = b[i] - ax;
+            out[i] = absolute ? ax : b[i] - ax;
         }
     }
+}
+
+static void residual(sem_linear_solver *s, const double *b, const double *x, double *r)
+{
+    share_sum(s, 0, b, x, r);
 }
 
 void sem_linear_solver_residual(sem_linear_solver *s, const double *b, const double *x, double *r,
@@ -346,28 +356,17 @@ void sem_linear_solver_residual(sem_linear_solver *s, const double *b, const dou
     residual(s, bp, xp, rp);
     for (size_t k = 0; k < n; ++k) r[s->perm[k]] = rp[k];
     if (!scale) return;
-    /* |A| |x|, in the same shares */
     for (size_t k = 0; k < n; ++k) xp[k] = fabs(xp[k]);
-#pragma omp parallel
-    {
-#pragma omp for schedule(static)
-        for (int t = 0; t < RESIDUAL_SHARES; ++t) share_abs_product(s, t, xp, s->partial + (size_t)t * n);
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; ++i) {
-            double ax = 0;
-            for (int t = 0; t < RESIDUAL_SHARES; ++t) ax += s->partial[(size_t)t * n + i];
-            rp[i] = ax;
-        }
-    }
+    share_sum(s, 1, NULL, xp, rp);
     for (size_t k = 0; k < n; ++k) scale[s->perm[k]] = rp[k];
 }
 
-/* One step of iterative refinement: SEM systems mix the mass matrix with the stiff error
- * term (Eq. 16), and the refinement recovers the digits the factorization loses, so that
- * conserved quantities (momentum) hold to round-off. Everything runs in the permuted order
- * of A: b is gathered through perm on the way in, x scattered on the way out. */
-sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double *x,
-                                   sem_error *err)
+/* x = A^-1 b, with one step of iterative refinement when refine is set: SEM systems mix the
+ * mass matrix with the stiff error term (Eq. 16), and the refinement recovers the digits the
+ * factorization loses, so that conserved quantities (momentum) hold to round-off. Everything
+ * runs in the permuted order of A: b is gathered through perm on the way in, x scattered on
+ * the way out. */
+static sem_status solve_permuted(sem_linear_solver *s, const double *b, double *x, int refine, sem_error *err)
 {
     size_t n = (size_t)s->n;
     double *bp = s->work, *xp = s->work + n, *r = s->work + 2 * n;
@@ -375,28 +374,27 @@ sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double
     openblas_set_num_threads(SEM_SOLVER_BLAS_THREADS);
     for (size_t k = 0; k < n; ++k) bp[k] = b[s->perm[k]];
     sem_status st = solve_once(s, bp, xp, err);
-    if (st == SEM_OK) {
+    if (st == SEM_OK && refine) {
         residual(s, bp, xp, r);
         st = solve_once(s, r, r, err);
         if (st == SEM_OK)
-            for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k] + r[k];
+            for (size_t k = 0; k < n; ++k) xp[k] += r[k];
     }
-    openblas_set_num_threads(blas_threads);
-    return st;
-}
-
-sem_status sem_linear_solver_solve_plain(sem_linear_solver *s, const double *b, double *x, sem_error *err)
-{
-    size_t n = (size_t)s->n;
-    double *bp = s->work, *xp = s->work + n;
-    int blas_threads = openblas_get_num_threads();
-    openblas_set_num_threads(SEM_SOLVER_BLAS_THREADS);
-    for (size_t k = 0; k < n; ++k) bp[k] = b[s->perm[k]];
-    sem_status st = solve_once(s, bp, xp, err);
     if (st == SEM_OK)
         for (size_t k = 0; k < n; ++k) x[s->perm[k]] = xp[k];
     openblas_set_num_threads(blas_threads);
     return st;
+}
+
+sem_status sem_linear_solver_solve(sem_linear_solver *s, const double *b, double *x,
+                                   sem_error *err)
+{
+    return solve_permuted(s, b, x, 1, err);
+}
+
+sem_status sem_linear_solver_solve_plain(sem_linear_solver *s, const double *b, double *x, sem_error *err)
+{
+    return solve_permuted(s, b, x, 0, err);
 }
 
 static sem_status solve_once(sem_linear_solver *s, const double *b, double *x, sem_error *err)
