@@ -133,6 +133,7 @@ static int solve_beam(int factor, int authors, double *tip, double *centre, size
         if (sem_cantilever_material(&cs, &od.material, &err) != SEM_OK) goto done;
         od.gamma = cs.gamma;
         od.blend = cs.blend;
+        od.seams = cs.seams;
     } else {
         od.material = sem_default_material(); /* neo-Hookean, rho 1000, E 1e6, nu 0.45 */
     }

@@ -5,9 +5,9 @@
  * - same problem, same answer: turned about several axes with its gravity and pins, the tip
  *   deflection changes by at most 3 % and the volume by at most 0.5 % (the quadrature is laid in
  *   the object's own frame; before, a turn of 90 degrees about z collapsed it);
- * - within 10 % of the FEM reference (4.238 m), and a load symmetric about the beam's planes of
- *   symmetry moves the tip sideways by less than 1 % of the deflection (the origins of Sec. 6.2
- *   are chosen symmetrically);
+ * - within 12 % of the FEM reference (4.238 m; 89.2 % measured, 99.3 % with 20 sections), and
+ *   a load symmetric about the beam's planes of symmetry moves the tip sideways by less than
+ *   1 % of the deflection (the origins of Sec. 6.2 are chosen symmetrically);
  * - the deflection rises towards FEM as sections are added (paper Fig. 10), now at defaults;
  * - a point takes the material of the solid it lies in whatever the ray direction:
  *   examples/two_materials.json has mass 496 kg (it was 640: every point took the material of
@@ -90,7 +90,10 @@ static beam_result solve_beam(int sections, const double R[9], const sem_preproc
     od.model = m;
     od.disc = d;
     od.material = sem_default_material(); /* neo-Hookean, rho 1000, E 1e6, nu 0.45 */
-    if (opt && opt->origin_rule == SEM_ORIGINS_PAPER) od.blend = 0; /* the authors' settings */
+    if (opt && opt->origin_rule == SEM_ORIGINS_PAPER) { /* the authors' settings */
+        od.blend = 0;
+        od.seams = SEM_SEAMS_PAPER;
+    }
     od.pinned = pin;
     if (!w || sem_world_add_object(w, &od, &err) < 0 || sem_world_solve_static(w, &err) != SEM_OK) {
         CHECK(0, "solve (%d sections): %s", sections, err.message);
@@ -160,7 +163,9 @@ static void test_same_problem_same_answer(double fem)
                100 * r.tip / fem, r.side, r.volume);
         if (k == 0) {
             ref = r;
-            CHECK(fabs(r.tip / fem - 1) <= 0.10, "default b10 tip %.4f m, FEM %.4f m", r.tip, fem);
+            /* 89.2 % measured (96.7 % before the geometric seams, a figure that depended on the
+             * control net: refined by 4 the same beam gave 107.6 %; docs/refine.md) */
+            CHECK(fabs(r.tip / fem - 1) <= 0.12, "default b10 tip %.4f m, FEM %.4f m", r.tip, fem);
             CHECK_REL(r.volume, 5.0, 1e-6);
         }
         CHECK(fabs(r.tip / ref.tip - 1) <= 0.03, "turned tip %.6f vs %.6f", r.tip, ref.tip);
@@ -171,13 +176,14 @@ static void test_same_problem_same_answer(double fem)
 }
 
 /* The paper's Fig. 10 at defaults: the deflection rises towards FEM as sections are added.
- * Measured: 42.7, 82.3, 90.7, 89.6, 92.3, 96.0 % for 1, 2, 3, 4, 6, 10 sections. */
+ * Measured: 40.3, 76.5, 85.7, 84.9, 85.5, 89.2, 99.3 % for 1, 2, 3, 4, 6, 10, 20 sections (with
+ * the paper's seam weighting: 42.7, 82.3, 90.7, 89.6, 92.3, 96.7, 107.9 %, overshooting). */
 static void test_deflection_rises(double fem)
 {
-    const int sections[] = {1, 2, 3, 4, 6, 10};
-    const int n = getenv("SEM_SANITIZED") ? 3 : 6;
+    const int sections[] = {1, 2, 3, 4, 6, 10, 20};
+    const int n = getenv("SEM_SANITIZED") ? 3 : 7;
     const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    double pct[6] = {0}, best = 0;
+    double pct[7] = {0}, best = 0;
     for (int k = 0; k < n; ++k) {
         beam_result r = solve_beam(sections[k], I, NULL);
         if (!r.ok) return;
@@ -189,7 +195,10 @@ static void test_deflection_rises(double fem)
         if (k >= 3) CHECK(pct[k] >= best - 3 && pct[k] <= 110, "%d sections %.1f %% (best before %.1f %%)", sections[k], pct[k], best);
         if (pct[k] > best) best = pct[k];
     }
-    if (n == 6) CHECK(fabs(pct[5] - 100) <= 10, "10 sections at %.1f %% of FEM", pct[5]);
+    if (n == 7) {
+        CHECK(fabs(pct[5] - 100) <= 12, "10 sections at %.1f %% of FEM", pct[5]);
+        CHECK(fabs(pct[6] - 100) <= 3, "20 sections at %.1f %% of FEM", pct[6]);
+    }
 }
 
 /* The explicit settings of the paper still work as before (authors' b10 figure). */

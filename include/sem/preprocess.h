@@ -93,6 +93,10 @@ typedef struct sem_discretization {
     double *sample_uv;     /* 2 per sample */
     double *sample_X;      /* rest position, 3 per sample */
     double *sample_area;   /* area weight (diagonal of S) */
+    /* the weight of the sample as a seam sample: sample_area as if the part were a single
+     * knot span across each side of its parameter range the sample lies on (sample_area
+     * elsewhere); a property of the part, not of its knot spans (docs/refine.md) */
+    double *sample_seam;
     sem_csr J_hat;         /* n_samples x n_ctrl: x(sample) = J_hat Q */
 
     /* the object's frame (object_frame.c): rows of frame_axes are unit axes by decreasing

@@ -53,6 +53,7 @@ typedef struct sem_scene_object {
     sem_scene_part_material *part_materials;
     sem_preprocess_options sem;
     double blend;              /* sem.blend: sem_object_def.blend (default SEM_DEFAULT_BLEND) */
+    int seams;                 /* sem.seams: sem_object_def.seams (default SEM_SEAMS_GEOMETRIC) */
     int has_pin_box;
     double pin_box[6];
     int n_pin_parts;

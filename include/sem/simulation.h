@@ -125,6 +125,10 @@ typedef struct sem_object_def {
      * (rigid, affine), so it leaves the patch test and momentum alone; it stiffens the motions
      * Eq. 15 leaves free (see docs/simulation.md, "Zero-energy modes"). */
     double blend;
+    /* How the error energy (Eq. 16) treats a boundary sample shared by several parts (on a
+     * seam): SEM_SEAMS_GEOMETRIC (0, the default) or SEM_SEAMS_PAPER (docs/refine.md,
+     * "Seams"). */
+    int seams;
     const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
     sem_prescribe prescribe;             /* motion of every pinned point (all points when
                                             pinned is NULL), unless prescribe_group is given */
@@ -145,6 +149,16 @@ typedef struct sem_object_def {
 } sem_object_def;
 
 #define SEM_DEFAULT_BLEND 0.02
+
+/* sem_object_def.seams. PAPER: the residual of the blended map, |sum_i w_i P_i(X) - x|^2,
+ * weighted by the sample's area in its knot span (Eq. 16 as written). GEOMETRIC: the
+ * partition form sum_i w_i |P_i(X) - x|^2 (which adds the spread of the polynomials about
+ * their blend), weighted as if each part were one knot span across the seam, so that the
+ * coupling of two parts depends on their geometry and not on their control nets: a model
+ * refined by knot insertion deflects as the original. Samples of one part are the same in
+ * both. */
+#define SEM_SEAMS_GEOMETRIC 0
+#define SEM_SEAMS_PAPER 1
 
 /* Default material, blend SEM_DEFAULT_BLEND, friction SEM_DEFAULT_FRICTION, everything else
  * zero / NULL. */

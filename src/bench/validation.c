@@ -44,6 +44,7 @@ sem_cantilever_settings sem_default_cantilever_settings(void)
     s.threads = 0;
     s.projected_hessian = 0;
     s.blend = 0.0;
+    s.seams = SEM_SEAMS_PAPER;
     return s;
 }
 
@@ -169,6 +170,7 @@ sem_status sem_cantilever_solve(const sem_model *model, const sem_cantilever_set
     if ((st = sem_cantilever_material(s, &od.material, err)) != SEM_OK) goto done;
     od.gamma = s->gamma;
     od.blend = s->blend;
+    od.seams = s->seams;
     od.pinned = pin;
     if (sem_world_add_object(w, &od, err) < 0) {
         st = err ? err->status : SEM_ERR_INVALID;

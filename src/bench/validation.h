@@ -23,6 +23,7 @@ typedef struct sem_cantilever_settings {
     double alpha;            /* 0.501 */
     double gamma;            /* error stiffness; <= 0: the preprocessing default (kappa E / L) */
     double blend;            /* sem_object_def.blend; 0: none, as in the paper */
+    int seams;               /* sem_object_def.seams; SEM_SEAMS_PAPER, as in the paper */
     sem_material_type material; /* neo-Hookean (the paper's) */
     double density, youngs_modulus, poisson_ratio; /* 1000, 1e6, 0.45 */
     double gravity;          /* 10 m/s^2 along -z */

@@ -85,6 +85,7 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     od.model = m;
     od.disc = d;
     od.blend = defaults ? SEM_DEFAULT_BLEND : 0; /* 0: the authors' discretization */
+    od.seams = defaults ? SEM_SEAMS_GEOMETRIC : SEM_SEAMS_PAPER;
     od.material.density = r->density;
     od.material.youngs_modulus = r->youngs_modulus;
     od.material.poisson_ratio = r->poisson_ratio;

@@ -32,6 +32,7 @@ sem_status output_write_preprocess(const char *path, const sem_discretization *d
     light.sample_uv = NULL;
     light.sample_X = NULL;
     light.sample_area = NULL;
+    light.sample_seam = NULL;
     light.J_hat = empty_like(&d->J_hat, 0);
     light.W_samples = empty_like(&d->W_samples, 0);
     light.Gamma = empty_like(&d->Gamma, d->n_quad);

@@ -87,11 +87,20 @@ const double *sem_centered(sem_object *o, const double *q);
 /* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties) and their CSR
  * copy. */
 sem_status sem_mass_error_init(sem_object *o, sem_error *err);
-/* The boundary samples' weights in the error matrix: their areas, each at least 5 % of its
- * part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area element
- * and its samples would drop out, and with them the only information that fixes the control
- * points of the collapsed row (the system would be singular). weight: n_samples. */
-sem_status sem_sample_weights(const sem_object *o, double *weight, sem_error *err);
+/* The boundary samples' weights in the error matrix are their areas, each at least 5 % of
+ * its part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area
+ * element and its samples would drop out, and with them the only information that fixes the
+ * control points of the collapsed row (the system would be singular). */
+/* The rows of the error energy (Eq. 16): per boundary sample one row, the residual of the
+ * blended map (entry -1), except on a seam under SEM_SEAMS_GEOMETRIC (a sample whose W_samples
+ * row has several parts): one row per part, the residual of that part's polynomial alone
+ * (entry: the W_samples entry), weighted by the part's weight times the sample's seam weight
+ * (sem_discretization.sample_seam, with the floor of sem_sample_weights). In sample order. */
+typedef struct sem_error_row {
+    int sample, entry;
+    double weight;
+} sem_error_row;
+sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows, sem_error *err);
 /* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (into grad). */
 double sem_error_energy(sem_object *o, const double *q, double *grad);
 /* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all the object's dofs. */

@@ -8,6 +8,7 @@
 #include "structured.h"
 
 #include <cblas.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,26 +67,59 @@ static void add_projected(const sem_object *o, int pa, int pb, const double *X, 
                 nb, 1.0, block, nb);
 }
 
-sem_status sem_sample_weights(const sem_object *o, double *weight, sem_error *err)
+/* The error rows' floor (assembly.h): 5 % of each part's mean sample area, per part. */
+static double *part_floors(const sem_discretization *d, int n_parts)
 {
-    const sem_discretization *d = o->d;
-    double *part_mean = calloc((size_t)o->n_parts + 1, sizeof(double));
-    int *part_count = calloc((size_t)o->n_parts + 1, sizeof(int));
+    double *part_mean = calloc((size_t)n_parts + 1, sizeof(double));
+    int *part_count = calloc((size_t)n_parts + 1, sizeof(int));
     if (!part_mean || !part_count) {
         free(part_mean);
         free(part_count);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        return NULL;
     }
     for (int r = 0; r < d->n_samples; ++r) {
         part_mean[d->sample_part[r]] += d->sample_area[r];
         part_count[d->sample_part[r]]++;
     }
-    for (int i = 0; i < o->n_parts; ++i)
-        if (part_count[i]) part_mean[i] /= part_count[i];
-    for (int r = 0; r < d->n_samples; ++r)
-        weight[r] = fmax(d->sample_area[r], 0.05 * part_mean[d->sample_part[r]]);
-    free(part_mean);
+    for (int i = 0; i < n_parts; ++i) part_mean[i] = part_count[i] ? 0.05 * part_mean[i] / part_count[i] : 0;
     free(part_count);
+    return part_mean;
+}
+
+sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows, sem_error *err)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *Ws = &d->W_samples;
+    const int split = o->def.seams != SEM_SEAMS_PAPER;
+    *rows = NULL;
+    *n_rows = 0;
+    size_t n = 0;
+    for (int r = 0; r < d->n_samples; ++r) {
+        int k = Ws->row_start[r + 1] - Ws->row_start[r];
+        n += split && k > 1 ? (size_t)k : 1;
+    }
+    if (n > (size_t)INT_MAX / 2) return sem_error_set(err, SEM_ERR_INVALID, "too many error rows (%zu)", n);
+    double *part_floor = part_floors(d, o->n_parts);
+    sem_error_row *out = malloc((n + 1) * sizeof *out);
+    if (!part_floor || !out) {
+        free(part_floor);
+        free(out);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    size_t at = 0;
+    for (int r = 0; r < d->n_samples; ++r) {
+        double fl = part_floor[d->sample_part[r]];
+        int e0 = Ws->row_start[r], e1 = Ws->row_start[r + 1];
+        if (!split || e1 - e0 <= 1) {
+            out[at++] = (sem_error_row){r, -1, fmax(d->sample_area[r], fl)};
+            continue;
+        }
+        double seam = fmax(d->sample_seam ? d->sample_seam[r] : d->sample_area[r], fl);
+        for (int e = e0; e < e1; ++e) out[at++] = (sem_error_row){r, e, seam * Ws->val[e]};
+    }
+    free(part_floor);
+    *rows = out;
+    *n_rows = (int)n;
     return SEM_OK;
 }
 
@@ -236,46 +270,73 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         free(tie_ctrl);
         free(tie_part);
     }
-    /* Error matrix (Eq. 16) as a sum of outer products of r_s = Gamma_s - J_s, so it is
-     * positive semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J
-     * cancels large terms, and its round-off can leave small negative eigenvalues exactly in
-     * the directions the mass matrix does not see (M has rank at most the number of
-     * quadrature points per coordinate), which makes M + h^2 (K + 2 gamma M_eps) indefinite. */
+    /* Error matrix (Eq. 16) as a sum of outer products of its rows' residuals r (Gamma_s - J_s,
+     * or P_i(X_s) Pi_i - J_s on a split seam: sem_error_rows), so it is positive
+     * semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J cancels
+     * large terms, and its round-off can leave small negative eigenvalues exactly in the
+     * directions the mass matrix does not see (M has rank at most the number of quadrature
+     * points per coordinate), which makes M + h^2 (K + 2 gamma M_eps) indefinite. */
     {
         const sem_csr *G = &o->d->Gamma_samples, *J = &o->d->J_hat;
+        sem_error_row *rows = NULL;
+        int n_rows = 0;
         int *rc = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
         double *rv = malloc(((size_t)o->n_ctrl + 1) * sizeof(double));
-        if (!rc || !rv) {
-            free(rc);
-            free(rv);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        double *weight = malloc(((size_t)o->d->n_samples + 1) * sizeof(double));
-        sem_status st = weight ? sem_sample_weights(o, weight, err) : sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        int *slot = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
+        sem_status st = rc && rv && slot ? sem_error_rows(o, &rows, &n_rows, err)
+                                         : sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         if (st != SEM_OK) {
-            free(weight);
             free(rc);
             free(rv);
+            free(slot);
             return st;
         }
-        for (int r = 0; r < G->n_rows; ++r) {
-            /* merge the sorted rows of Gamma_s and J_s */
-            int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
-            int n = 0;
-            while (a < ae || b < be) {
-                if (b >= be || (a < ae && G->col[a] < J->col[b])) {
-                    rc[n] = G->col[a];
-                    rv[n++] = G->val[a++];
-                } else if (a >= ae || J->col[b] < G->col[a]) {
-                    rc[n] = J->col[b];
-                    rv[n++] = -J->val[b++];
-                } else {
-                    rc[n] = G->col[a];
-                    rv[n++] = G->val[a++] - J->val[b++];
+        for (int c = 0; c < o->n_ctrl; ++c) slot[c] = -1;
+        for (int t = 0; t < n_rows && st == SEM_OK; ++t) {
+            int r = rows[t].sample, n = 0;
+            if (rows[t].entry < 0) {
+                /* merge the sorted rows of Gamma_s and J_s */
+                int a = G->row_start[r], ae = G->row_start[r + 1], b = J->row_start[r], be = J->row_start[r + 1];
+                while (a < ae || b < be) {
+                    if (b >= be || (a < ae && G->col[a] < J->col[b])) {
+                        rc[n] = G->col[a];
+                        rv[n++] = G->val[a++];
+                    } else if (a >= ae || J->col[b] < G->col[a]) {
+                        rc[n] = J->col[b];
+                        rv[n++] = -J->val[b++];
+                    } else {
+                        rc[n] = G->col[a];
+                        rv[n++] = G->val[a++] - J->val[b++];
+                    }
                 }
+            } else {
+                /* part i's polynomial at the sample, b(X - Xbar)^T Pi_i over its group, minus J_s */
+                int i = o->d->W_samples.col[rows[t].entry], g = o->d->part_origin[i];
+                size_t ng = sem_group_size(o, g);
+                const int *gc = o->group_ctrl + o->group_start[g];
+                const double *X = o->d->sample_X + 3 * (size_t)r, *Xb = o->d->origin_X + 3 * (size_t)g;
+                double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, bs[10];
+                sem_polynomial_basis(o->d->order, dX, bs, NULL);
+                for (size_t l = 0; l < ng; ++l) {
+                    double v = 0;
+                    for (int k = 0; k < m; ++k) v += bs[k] * o->pi_dense[i][(size_t)k * ng + l];
+                    slot[gc[l]] = n;
+                    rc[n] = gc[l];
+                    rv[n++] = v;
+                }
+                for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e) {
+                    int c = J->col[e];
+                    if (slot[c] >= 0) {
+                        rv[slot[c]] -= J->val[e];
+                    } else {
+                        rc[n] = c;
+                        rv[n++] = -J->val[e];
+                    }
+                }
+                for (size_t l = 0; l < ng; ++l) slot[gc[l]] = -1;
             }
-            double area = weight[r];
-            for (int x = 0; x < n; ++x) {
+            double area = rows[t].weight;
+            for (int x = 0; x < n && st == SEM_OK; ++x) {
                 int gx = o->ctrl_group[rc[x]];
                 double ax = area * rv[x];
                 if (ax == 0) continue;
@@ -283,10 +344,8 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                     int gy = o->ctrl_group[rc[y]];
                     int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
                     if (gp < 0) {
-                        free(weight);
-                        free(rc);
-                        free(rv);
-                        return sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
+                        st = sem_error_set(err, SEM_ERR_INVALID, "error matrix pattern outside the system pattern");
+                        break;
                     }
                     size_t nb = sem_group_size(o, gy);
                     o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[rc[x]] * nb + (size_t)o->ctrl_local[rc[y]]] +=
@@ -294,9 +353,11 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                 }
             }
         }
-        free(weight);
+        free(rows);
         free(rc);
         free(rv);
+        free(slot);
+        if (st != SEM_OK) return st;
     }
     return SEM_OK;
 }

@@ -78,7 +78,7 @@ static double discretization_bytes(const sem_discretization *d)
 {
     double b = 0;
     b += ((double)d->n_parts + 1) * BYTES_INT * 3; /* ctrl offsets, origins, covered */
-    b += (double)d->n_samples * (BYTES_INT + 6 * BYTES_DOUBLE); /* part, uv, X, area */
+    b += (double)d->n_samples * (BYTES_INT + 7 * BYTES_DOUBLE); /* part, uv, X, area, seam */
     b += (double)d->n_quad * (BYTES_INT + 4 * BYTES_DOUBLE);    /* part, X, volume */
     b += (double)d->n_origins * 3 * BYTES_DOUBLE;
     const sem_csr *mats[] = {&d->J_hat, &d->W, &d->W_samples, &d->Pi, &d->Gamma,

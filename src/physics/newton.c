@@ -28,69 +28,82 @@ typedef struct newton {
     double *tmp, *dq;             /* scratch */
 } newton;
 
-/* E(q) of the system (the sum over its objects); +inf where undefined (an inverted
- * element). Uses tmp and dq as scratch. */
-static double potential(const newton *nt, const double *q)
+/* The line search compares energies by their differences. The potential is the elastic
+ * energy V and the contact potential Ec (sums of small non-negative terms, accurate to
+ * round-off of their size) plus a quadratic Q(q) = 1/2 q^T A q - b^T q: inertia, damping,
+ * loads and the error energy (A = cM M + 2 gamma M_eps + cD K0). Q itself is a sum of large
+ * terms that cancel (gamma M_eps has entries far larger than the energy, since gamma is
+ * stiff), so evaluating it at two points and subtracting loses the few digits a converging
+ * Newton step changes (measured: 1e-9 of an energy of 1 on a refined box, where a step
+ * changes it by 1e-9; the search then halved the step to nothing and stalled at a relative
+ * gradient of 1e-5). Its change along a step d is exact instead:
+ * Q(q + d) - Q(q) = d . grad Q(q) + 1/2 d . A d, with grad Q(q) from the gradient and A d one
+ * product. */
+
+/* V + Ec at q (the non-quadratic part of the potential); +inf where undefined (an inverted
+ * element). */
+static double nonquadratic(const newton *nt, const double *q)
 {
     const sem_system *s = nt->s;
-    const sem_world *w = nt->w;
-    double h = nt->h, total = 0;
+    double total = 0;
     for (int k = 0; k < s->n_objects; ++k) {
-        sem_object *o = s->objects[k];
-        size_t off = s->dof_offset[k], n = 3 * (size_t)o->n_ctrl;
-        const double *x = q + off, *f = nt->f + off, *qpred = nt->qpred + off, *qn = nt->qn + off;
-        double *tmp = nt->tmp + off, *dq = nt->dq + off;
         sem_error e;
-        if (sem_assemble_elastic(o, x, 0, NULL, NULL, &e) != SEM_OK) return INFINITY;
-        double E = o->elastic_energy + sem_error_energy(o, x, tmp);
-        for (size_t i = 0; i < n; ++i) E -= f[i] * x[i];
-        if (nt->dynamic) {
-            for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qpred[i];
-            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
-            for (size_t i = 0; i < n; ++i) E += 0.5 * dq[i] * tmp[i];
-            if (nt->cD > 0 || w->def.rayleigh_mass > 0) {
-                for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qn[i];
-                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, dq, tmp);
-                for (size_t i = 0; i < n; ++i) E += 0.5 * dq[i] * tmp[i];
-            }
-        }
-        total = k == 0 ? E : total + E;
+        if (sem_assemble_elastic(s->objects[k], q + s->dof_offset[k], 0, NULL, NULL, &e) != SEM_OK) return INFINITY;
+        total += s->objects[k]->elastic_energy;
     }
     /* contact: springs and friction (contact_world.h) */
     sem_error e;
-    double Ec = sem_contact_potential(w->contact, s, q, h, NULL, &e);
+    double Ec = sem_contact_potential(nt->w->contact, s, q, nt->h, NULL, &e);
     return isnan(Ec) ? INFINITY : total + Ec;
 }
 
+/* y = A x, the quadratic part's matrix (see above), over the system's vectors. */
+static void quadratic_multiply(const newton *nt, double cM, const double *x, double *y)
+{
+    const sem_system *s = nt->s;
+    for (int k = 0; k < s->n_objects; ++k) {
+        sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k];
+        sem_blocks_multiply(o, cM, o->gamma, 0, nt->cD, x + off, y + off);
+    }
+}
+
 /* The gradient g of E at q and, with the objects' K blocks, the Hessian's stiffness part:
- * grad V + 2 gamma M_eps q - f + M (q - q_pred) / h^2 + damping. */
-static sem_status gradient(const newton *nt, const double *q, double *g, sem_error *err)
+ * grad V + 2 gamma M_eps q - f + M (q - q_pred) / h^2 + damping + contact. gq: the gradient of
+ * the quadratic part alone; *vc: V + Ec at q. */
+static sem_status gradient(const newton *nt, const double *q, double *g, double *gq, double *vc,
+                           sem_error *err)
 {
     const sem_system *s = nt->s;
     const sem_world *w = nt->w;
     double h = nt->h;
+    *vc = 0;
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t off = s->dof_offset[k], n = 3 * (size_t)o->n_ctrl;
         const double *x = q + off, *f = nt->f + off, *qpred = nt->qpred + off, *qn = nt->qn + off;
-        double *gk = g + off, *tmp = nt->tmp + off, *dq = nt->dq + off;
+        double *gk = g + off, *qk = gq + off, *tmp = nt->tmp + off, *dq = nt->dq + off;
         sem_status st = sem_assemble_elastic(o, x, 1, gk, NULL, err);
         if (st != SEM_OK) return st;
-        sem_error_energy(o, x, tmp);
-        for (size_t i = 0; i < n; ++i) gk[i] += tmp[i] - f[i];
+        *vc += o->elastic_energy;
+        sem_error_energy(o, x, qk);
+        for (size_t i = 0; i < n; ++i) qk[i] -= f[i];
         if (nt->dynamic) {
             for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qpred[i];
             sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
-            for (size_t i = 0; i < n; ++i) gk[i] += tmp[i];
+            for (size_t i = 0; i < n; ++i) qk[i] += tmp[i];
             if (nt->cD > 0 || w->def.rayleigh_mass > 0) {
                 for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qn[i];
                 sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, dq, tmp);
-                for (size_t i = 0; i < n; ++i) gk[i] += tmp[i];
+                for (size_t i = 0; i < n; ++i) qk[i] += tmp[i];
             }
         }
+        for (size_t i = 0; i < n; ++i) gk[i] += qk[i];
     }
     /* contact: its gradient, and its Hessian's point terms for factorize() */
-    if (isnan(sem_contact_potential(w->contact, s, q, h, g, err))) return err ? err->status : SEM_ERR_NOMEM;
+    double Ec = sem_contact_potential(w->contact, s, q, h, g, err);
+    if (isnan(Ec)) return err ? err->status : SEM_ERR_NOMEM;
+    *vc += Ec;
     return SEM_OK;
 }
 
@@ -125,10 +138,11 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     double *f = malloc(n * sizeof(double) + 1), *g = malloc(n * sizeof(double) + 1);
     double *tmp = malloc(n * sizeof(double) + 1), *dq = calloc(n + 1, sizeof(double));
     double *qtry = malloc(n * sizeof(double) + 1), *dir = malloc(n * sizeof(double) + 1);
+    double *gq = malloc(n * sizeof(double) + 1), *adir = malloc(n * sizeof(double) + 1);
     double *fr = malloc(3 * (size_t)s->n_free * sizeof(double) + 1);
     sem_status st = SEM_OK;
     int gathered = 0;
-    if (!q || !qn || !qpred || !f || !g || !tmp || !dq || !qtry || !dir || !fr) {
+    if (!q || !qn || !qpred || !f || !g || !tmp || !dq || !qtry || !dir || !gq || !adir || !fr) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -152,14 +166,15 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     gathered = 1;
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
 
-    double g0norm = -1, last_rel = 0;
+    double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY;
     int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0;
     set_exact_hessian(s, 0);
     for (it = 0; it < max_iterations; ++it) {
         /* the exact Hessian after two full steps in a row (see integrators.h) */
         int exact = exact_allowed && full_steps >= 2;
         set_exact_hessian(s, exact);
-        if ((st = gradient(&nt, q, g, err)) != SEM_OK) goto done;
+        double vc0 = 0;
+        if ((st = gradient(&nt, q, g, gq, &vc0, err)) != SEM_OK) goto done;
         sem_system_gather_free(s, g, fr);
         double gnorm = 0, fscale = 0;
         for (int i = 0; i < 3 * s->n_free; ++i) gnorm += fr[i] * fr[i];
@@ -193,14 +208,32 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         if (st != SEM_OK) goto done;
         memset(dir, 0, n * sizeof(double));
         sem_system_scatter_free(s, fr, dir);
-        double slope = 0;
-        for (size_t i = 0; i < n; ++i) slope -= dir[i] * g[i];
-        double E0 = potential(&nt, q);
-        double step = 1.0, Et = INFINITY;
+        /* along -dir: E(q - t dir) - E(q) = [V + Ec](q - t dir) - vc0 - t dir.gq + t^2/2 dir.A dir */
+        quadratic_multiply(&nt, cM, dir, adir);
+        double slope = 0, lin = 0, curv = 0;
+        for (size_t i = 0; i < n; ++i) {
+            slope -= dir[i] * g[i];
+            lin += dir[i] * gq[i];
+            curv += dir[i] * adir[i];
+        }
+        /* The Newton decrement (-slope: the decrease the step promises) below what the energy
+         * resolves: the energy cannot judge the step, but the quadratic model is exact there,
+         * so the full step is taken, for as long as it halves the gradient. When it no longer
+         * does, q is an equilibrium to round-off (a relative gradient cannot tell when the
+         * first gradient is round-off itself, e.g. a static step that nothing moves). */
+        int unresolved = -slope <= 1e-14 * fabs(vc0);
+        if (unresolved && gnorm >= 0.5 * prev_gnorm) {
+            ++it;
+            converged = 1;
+            break;
+        }
+        prev_gnorm = gnorm;
+        double step = 1.0, dE = INFINITY;
         for (int ls = 0; ls < 40; ++ls) {
             for (size_t i = 0; i < n; ++i) qtry[i] = q[i] - step * dir[i];
-            Et = potential(&nt, qtry);
-            if (Et <= E0 + 1e-4 * step * slope || (isfinite(Et) && fabs(Et - E0) <= 1e-14 * fabs(E0)))
+            dE = nonquadratic(&nt, qtry) - vc0 - step * lin + 0.5 * step * step * curv;
+            /* (or, valid, a change the non-quadratic part's round-off cannot resolve) */
+            if (dE <= 1e-4 * step * slope || (isfinite(dE) && (unresolved || fabs(dE) <= 1e-14 * fabs(vc0))))
                 break;
             step *= 0.5;
         }
@@ -209,11 +242,11 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
         if (w->def.advanced.trace_newton && w->def.log) {
             char line[256];
-            snprintf(line, sizeof line, "newton it %d: |g| %.6g E0 %.12g Et %.12g step %g slope %g dmax %g", it,
-                     gnorm, E0, Et, step, slope, dmax);
+            snprintf(line, sizeof line, "newton it %d: |g| %.6g dE %.6g step %g slope %g dmax %g", it, gnorm,
+                     dE, step, slope, dmax);
             w->def.log(w->def.log_user, 0, line);
         }
-        if (!isfinite(Et)) {
+        if (!isfinite(dE)) {
             st = sem_error_set(err, SEM_ERR_NUMERIC,
                                "Newton line search found no valid configuration at t = %g", t1);
             goto done;
@@ -276,6 +309,8 @@ done:
     free(dq);
     free(qtry);
     free(dir);
+    free(gq);
+    free(adir);
     free(fr);
     return st;
 }

@@ -64,25 +64,33 @@ static sem_status build_P(sem_object *o, sem_structured_ops *s, sem_error *err)
     return SEM_OK;
 }
 
-/* The sample rows (boundary samples, then ties) and Bb. */
+/* The sample rows (the error rows of sem_error_rows, then ties) and Bb. */
 static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties, const int *tie_ctrl,
                                 const int *tie_part, double tie_weight, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *J = &d->J_hat, *Ws = &d->W_samples;
-    int m = o->m, ns = d->n_samples, nr = ns + n_ties, r0 = s->r0;
+    sem_error_row *rows = NULL;
+    int n_err = 0;
+    sem_status st = sem_error_rows(o, &rows, &n_err, err);
+    if (st != SEM_OK) return st;
+    int m = o->m, ns = n_err, nr = ns + n_ties, r0 = s->r0;
     s->n_rows = nr;
     s->area = malloc(((size_t)nr + 1) * sizeof(double));
     s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
     s->g_start = malloc(((size_t)nr + 1) * sizeof(int));
-    if (!s->area || !s->j_start || !s->g_start) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    sem_status st = sem_sample_weights(o, s->area, err); /* mass_error.c's floor */
-    if (st != SEM_OK) return st;
+    if (!s->area || !s->j_start || !s->g_start) {
+        free(rows);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int t = 0; t < ns; ++t) s->area[t] = rows[t].weight;
     for (int t = 0; t < n_ties; ++t) s->area[ns + t] = tie_weight;
     s->j_start[0] = s->g_start[0] = 0;
-    for (int r = 0; r < ns; ++r) {
-        s->j_start[r + 1] = s->j_start[r] + (J->row_start[r + 1] - J->row_start[r]);
-        s->g_start[r + 1] = s->g_start[r] + m * (Ws->row_start[r + 1] - Ws->row_start[r]);
+    for (int t = 0; t < ns; ++t) {
+        int r = rows[t].sample;
+        int parts = rows[t].entry < 0 ? Ws->row_start[r + 1] - Ws->row_start[r] : 1;
+        s->j_start[t + 1] = s->j_start[t] + (J->row_start[r + 1] - J->row_start[r]);
+        s->g_start[t + 1] = s->g_start[t] + m * parts;
     }
     for (int t = 0; t < n_ties; ++t) {
         s->j_start[ns + t + 1] = s->j_start[ns + t] + 1;
@@ -94,24 +102,32 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     s->g_idx = malloc((ng + 1) * sizeof(int));
     s->g_val = malloc((ng + 1) * sizeof(double));
     s->Bb = calloc((size_t)r0 * r0 + 1, sizeof(double));
-    if (!s->j_col || !s->j_val || !s->g_idx || !s->g_val || !s->Bb)
+    if (!s->j_col || !s->j_val || !s->g_idx || !s->g_val || !s->Bb) {
+        free(rows);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the error matrix's samples");
-    memcpy(s->j_col, J->col, (size_t)J->row_start[ns] * sizeof(int));
-    memcpy(s->j_val, J->val, (size_t)J->row_start[ns] * sizeof(double));
+    }
 #pragma omp parallel for schedule(static)
-    for (int r = 0; r < ns; ++r) {
-        int at = s->g_start[r];
-        for (int e = Ws->row_start[r]; e < Ws->row_start[r + 1]; ++e) {
+    for (int t = 0; t < ns; ++t) {
+        int r = rows[t].sample;
+        size_t len = (size_t)(J->row_start[r + 1] - J->row_start[r]);
+        memcpy(s->j_col + s->j_start[t], J->col + J->row_start[r], len * sizeof(int));
+        memcpy(s->j_val + s->j_start[t], J->val + J->row_start[r], len * sizeof(double));
+        int at = s->g_start[t];
+        int e0 = rows[t].entry < 0 ? Ws->row_start[r] : rows[t].entry;
+        int e1 = rows[t].entry < 0 ? Ws->row_start[r + 1] : rows[t].entry + 1;
+        for (int e = e0; e < e1; ++e) {
             int i = Ws->col[e];
             const double *X = d->sample_X + 3 * (size_t)r, *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
             double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, b[10];
             sem_polynomial_basis(d->order, dX, b, NULL);
+            double w = rows[t].entry < 0 ? Ws->val[e] : 1.0;
             for (int k = 0; k < m; ++k) {
                 s->g_idx[at] = i * m + k;
-                s->g_val[at++] = Ws->val[e] * b[k];
+                s->g_val[at++] = w * b[k];
             }
         }
     }
+    free(rows);
     for (int t = 0; t < n_ties; ++t) {
         int c = tie_ctrl[t], i = tie_part[t], r = ns + t;
         s->j_col[s->j_start[r]] = c;

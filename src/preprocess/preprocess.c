@@ -44,7 +44,7 @@
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
 
-#define SEM_DISC_FORMAT_VERSION 4u
+#define SEM_DISC_FORMAT_VERSION 5u
 #define SEM_DISC_BYTE_ORDER 0x01020304u
 static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
 
@@ -258,6 +258,7 @@ void sem_discretization_destroy(sem_discretization *d)
     free(d->sample_uv);
     free(d->sample_X);
     free(d->sample_area);
+    free(d->sample_seam);
     sem_csr_free(&d->J_hat);
     free(d->quad_X);
     free(d->quad_volume);
@@ -626,6 +627,7 @@ sem_status sem_discretization_save(const sem_discretization *d, const char *path
     w_doubles(&w, d->sample_uv, d->sample_uv ? 2 * (size_t)d->n_samples : 0);
     w_doubles(&w, d->sample_X, d->sample_X ? 3 * (size_t)d->n_samples : 0);
     w_doubles(&w, d->sample_area, d->sample_area ? (size_t)d->n_samples : 0);
+    w_doubles(&w, d->sample_seam, d->sample_seam ? (size_t)d->n_samples : 0);
     w_csr(&w, &d->J_hat);
     w_doubles(&w, d->quad_X, d->quad_X ? 3 * (size_t)d->n_quad : 0);
     w_doubles(&w, d->quad_volume, d->quad_volume ? (size_t)d->n_quad : 0);
@@ -938,6 +940,7 @@ sem_status sem_discretization_load_buffer(const char *name, const void *bytes, s
         d->sample_uv = r_doubles(&r, 2 * S, "sample_uv");
         d->sample_X = r_doubles(&r, 3 * S, "sample_X");
         d->sample_area = r_doubles(&r, S, "sample_area");
+        d->sample_seam = r_doubles(&r, S, "sample_seam");
         r_csr(&r, &d->J_hat, d->n_samples, d->n_ctrl, "J_hat");
         d->quad_X = r_doubles(&r, 3 * Q, "quad_X");
         d->quad_volume = r_doubles(&r, Q, "quad_volume");

@@ -52,6 +52,7 @@ typedef struct part_samples {
     double *uv;     /* 2n */
     double *X;      /* 3n */
     double *area;   /* n */
+    double *seam;   /* n: sample_seam (see sem_discretization) */
     int *row_nnz;   /* n */
     int *col;       /* nnz, local control point index */
     double *val;    /* nnz */
@@ -64,6 +65,7 @@ static void part_samples_free(part_samples *p)
     free(p->uv);
     free(p->X);
     free(p->area);
+    free(p->seam);
     free(p->row_nnz);
     free(p->col);
     free(p->val);
@@ -157,10 +159,11 @@ static void sample_part(const sem_part *part, int index, part_samples *out)
     out->uv = malloc(2 * capacity * sizeof *out->uv);
     out->X = malloc(3 * capacity * sizeof *out->X);
     out->area = malloc(capacity * sizeof *out->area);
+    out->seam = malloc(capacity * sizeof *out->seam);
     out->row_nnz = malloc(capacity * sizeof *out->row_nnz);
     out->col = malloc(capacity * (size_t)basis_max * sizeof *out->col);
     out->val = malloc(capacity * (size_t)basis_max * sizeof *out->val);
-    if (!out->uv || !out->X || !out->area || !out->row_nnz || !out->col || !out->val) goto nomem;
+    if (!out->uv || !out->X || !out->area || !out->seam || !out->row_nnz || !out->col || !out->val) goto nomem;
 
     for (int b = 0; b + 1 < n_bv; ++b) {
         double v_mid = 0.5 * (bv[b] + bv[b + 1]), v_half = 0.5 * (bv[b + 1] - bv[b]);
@@ -213,6 +216,14 @@ static void sample_part(const sem_part *part, int index, part_samples *out)
                     out->uv[2 * n + 1] = v;
                     memcpy(out->X + 3 * (size_t)n, X, sizeof X);
                     out->area[n] = area;
+                    /* the weight this sample would have, were the part one span across
+                     * each side of its range it lies on */
+                    double seam = 1.0;
+                    if ((k == 0 && a == 0) || (k == nu - 1 && a == n_bu - 2))
+                        seam *= (bu[n_bu - 1] - bu[0]) / (2.0 * u_half);
+                    if ((l == 0 && b == 0) || (l == nv - 1 && b == n_bv - 2))
+                        seam *= (bv[n_bv - 1] - bv[0]) / (2.0 * v_half);
+                    out->seam[n] = area * seam;
                     out->n++;
                 }
             }
@@ -296,7 +307,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
                            n_samples);
 
     int *sample_part_idx = NULL;
-    double *uv = NULL, *X = NULL, *area = NULL;
+    double *uv = NULL, *X = NULL, *area = NULL, *seam = NULL;
     sem_csr J;
     memset(&J, 0, sizeof J);
     if (st == SEM_OK) {
@@ -305,7 +316,8 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
         uv = malloc(2 * ns * sizeof *uv);
         X = malloc(3 * ns * sizeof *X);
         area = malloc(ns * sizeof *area);
-        if (!sample_part_idx || !uv || !X || !area ||
+        seam = malloc(ns * sizeof *seam);
+        if (!sample_part_idx || !uv || !X || !area || !seam ||
             sem_csr_alloc(&J, (int)n_samples, ctrl_offset[n_parts], nnz) != SEM_OK)
             st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
@@ -318,6 +330,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
                 memcpy(uv + 2 * s0, p->uv, 2 * n * sizeof *uv);
                 memcpy(X + 3 * s0, p->X, 3 * n * sizeof *X);
                 memcpy(area + s0, p->area, n * sizeof *area);
+                memcpy(seam + s0, p->seam, n * sizeof *seam);
             }
             for (size_t k = 0; k < n; ++k) {
                 sample_part_idx[s0 + k] = i;
@@ -338,6 +351,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
         free(uv);
         free(X);
         free(area);
+        free(seam);
         free(ctrl_offset);
         sem_csr_free(&J);
         return st;
@@ -350,6 +364,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
     d->sample_uv = uv;
     d->sample_X = X;
     d->sample_area = area;
+    d->sample_seam = seam;
     d->J_hat = J;
     return SEM_OK;
 }

@@ -255,7 +255,7 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
 {
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
-                                       "tessellation", "weight_threshold", "origins", "blend", NULL};
+                                       "tessellation", "weight_threshold", "origins", "blend", "seams", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -606,6 +606,17 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     if (s) {
         snprintf(w, sizeof w, "%s.sem", where);
         if ((st = parse_sem(c, s, w, &obj->sem)) != SEM_OK) return st;
+        const cJSON *sm = cJSON_GetObjectItemCaseSensitive(s, "seams");
+        if (sm) {
+            char w2[300];
+            snprintf(w2, sizeof w2, "%s.seams", w);
+            if (cJSON_IsString(sm) && !strcmp(sm->valuestring, "geometric"))
+                obj->seams = SEM_SEAMS_GEOMETRIC;
+            else if (cJSON_IsString(sm) && !strcmp(sm->valuestring, "paper"))
+                obj->seams = SEM_SEAMS_PAPER;
+            else
+                return fail(c, w2, "must be \"geometric\" or \"paper\"");
+        }
         const cJSON *bl = cJSON_GetObjectItemCaseSensitive(s, "blend");
         if (bl && !cJSON_IsNull(bl)) {
             if ((st = get_number(c, s, "blend", w, &obj->blend)) != SEM_OK) return st;

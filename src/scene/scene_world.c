@@ -266,6 +266,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.disc = sw->discs[i];
     od.material = so->material;
     od.blend = so->blend;
+    od.seams = so->seams;
     od.part_material = sw->part_material[i];
     od.part_materials = sw->materials[i];
     od.n_part_materials = so->n_part_materials;
