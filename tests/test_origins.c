@@ -1,8 +1,11 @@
 /* test_origins.c - deformation origins by min-cost flow (paper Sec. 6.2, Eq. 10): a small
  * case solved by hand, every part gets exactly one origin, isolated parts get their own,
- * the assignment is optimal on random networks, origins sit at area-weighted sample
- * centroids, bad input is rejected, and the flow is feasible on the shared models. */
+ * the assignment is optimal on random networks and the one GLPK's min-cost flow solver gives
+ * there and on the shared models (origins.c solves the network in closed form), origins sit
+ * at area-weighted sample centroids, bad input is rejected. */
+#include <glpk.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -155,6 +158,110 @@ static double rnd(void)
  * per part, every origin used, isolated parts alone, and each origin's parts all lie in
  * one group for which each of them pays its minimum cost (the capacities never bind, so
  * the optimum is that per-part minimum). */
+/* The network of origins.c's header, built from W and solved by GLPK's out-of-kilter
+ * algorithm (the reference: origins.c solves it in closed form). group[p]: the first row of
+ * the group (set of parts of a row of W with two parts or more) whose candidate part p takes,
+ * or -1. Returns the total (scaled, rounded) cost, or -1 on failure. */
+typedef struct ref_vertex {
+    double rhs;
+} ref_vertex;
+typedef struct ref_arc {
+    double low, cap, cost, x;
+} ref_arc;
+
+static double glpk_assignment(const sem_csr *W, int n_parts, int *group)
+{
+    int n = W->n_rows;
+    int *first = malloc((size_t)n * sizeof *first), n_groups = 0; /* groups by first row */
+    int *row_group = malloc((size_t)n * sizeof *row_group);
+    for (int r = 0; r < n; ++r) {
+        row_group[r] = -1;
+        int len = W->row_start[r + 1] - W->row_start[r];
+        if (len < 2) continue;
+        for (int g = 0; g < n_groups && row_group[r] < 0; ++g) {
+            int f = first[g], lf = W->row_start[f + 1] - W->row_start[f];
+            if (lf == len && !memcmp(&W->col[W->row_start[f]], &W->col[W->row_start[r]], (size_t)len * sizeof(int)))
+                row_group[r] = g;
+        }
+        if (row_group[r] < 0) {
+            first[n_groups] = r;
+            row_group[r] = n_groups++;
+        }
+    }
+    double *cost = calloc((size_t)n_groups * n_parts + 1, sizeof *cost);
+    double total = 0;
+    for (int r = 0; r < n; ++r)
+        if (row_group[r] >= 0)
+            for (int e = W->row_start[r]; e < W->row_start[r + 1]; ++e) {
+                cost[(size_t)row_group[r] * n_parts + W->col[e]] += W->val[e];
+                total += W->val[e];
+            }
+    int *in_some = calloc((size_t)n_parts, sizeof *in_some), n_covered = 0;
+    for (int g = 0; g < n_groups; ++g)
+        for (int e = W->row_start[first[g]]; e < W->row_start[first[g] + 1]; ++e)
+            if (!in_some[W->col[e]]) in_some[W->col[e]] = ++n_covered;
+    const int source = 1, first_candidate = 2, first_part = 2 + n_groups, sink = first_part + n_covered;
+    int prev = glp_term_out(GLP_OFF);
+    glp_graph *G = glp_create_graph((int)sizeof(ref_vertex), (int)sizeof(ref_arc));
+    glp_add_vertices(G, sink);
+    for (int v = 1; v <= sink; ++v) ((ref_vertex *)G->v[v]->data)->rhs = 0;
+    ((ref_vertex *)G->v[source]->data)->rhs = n_covered;
+    ((ref_vertex *)G->v[sink]->data)->rhs = -n_covered;
+    const double scale = total > 0 ? 1e9 / total : 0;
+    for (int g = 0; g < n_groups; ++g) {
+        int f = first[g], len = W->row_start[f + 1] - W->row_start[f];
+        ref_arc *a = glp_add_arc(G, source, first_candidate + g)->data;
+        *a = (ref_arc){0, len, 0, 0};
+        for (int e = W->row_start[f]; e < W->row_start[f + 1]; ++e) {
+            int p = W->col[e];
+            a = glp_add_arc(G, first_candidate + g, first_part + in_some[p] - 1)->data;
+            *a = (ref_arc){0, 1, floor(cost[(size_t)g * n_parts + p] * scale + 0.5), 0};
+        }
+    }
+    for (int p = 0; p < n_parts; ++p)
+        if (in_some[p]) {
+            ref_arc *a = glp_add_arc(G, first_part + in_some[p] - 1, sink)->data;
+            *a = (ref_arc){0, 1, 0, 0};
+        }
+    double opt = -1;
+    int ret = glp_mincost_okalg(G, (int)offsetof(ref_vertex, rhs), (int)offsetof(ref_arc, low),
+                                (int)offsetof(ref_arc, cap), (int)offsetof(ref_arc, cost), &opt,
+                                (int)offsetof(ref_arc, x), -1);
+    glp_term_out(prev);
+    for (int p = 0; p < n_parts; ++p) group[p] = -1;
+    if (ret == 0)
+        for (int g = 0; g < n_groups; ++g)
+            for (glp_arc *a = G->v[first_candidate + g]->out; a; a = a->t_next)
+                if (((ref_arc *)a->data)->x > 0.5)
+                    for (int p = 0; p < n_parts; ++p)
+                        if (in_some[p] && first_part + in_some[p] - 1 == a->head->i) group[p] = first[g];
+    glp_delete_graph(G);
+    free(first);
+    free(row_group);
+    free(cost);
+    free(in_some);
+    return ret == 0 ? opt : -1;
+}
+
+/* origins.c's assignment against GLPK's on d (after sem_step_origins): parts share an origin
+ * exactly when GLPK gave them the same candidate (parts of no candidate: alone). */
+static void check_against_glpk(const sem_discretization *d, const char *name)
+{
+    int *group = malloc(((size_t)d->n_parts + 1) * sizeof *group);
+    double opt = glpk_assignment(&d->W, d->n_parts, group);
+    CHECK(opt >= 0, "%s: GLPK's min-cost flow failed", name);
+    int differ = 0;
+    for (int p = 0; p < d->n_parts; ++p)
+        for (int q = p + 1; q < d->n_parts; ++q) {
+            int same_glpk = group[p] >= 0 && group[p] == group[q];
+            int same_ours = d->part_origin[p] == d->part_origin[q];
+            differ += same_glpk != same_ours;
+        }
+    printf("%s: origins against GLPK's min-cost flow (cost %.0f): %d part pairs differ\n", name, opt, differ);
+    CHECK(differ == 0, "%s: %d part pairs grouped differently from GLPK's min-cost flow", name, differ);
+    free(group);
+}
+
 static void test_random(void)
 {
     const int P = 40, N = 3000, n_sets = 60;
@@ -199,6 +306,7 @@ static void test_random(void)
     double t0 = now();
     CHECK(sem_step_origins(NULL, &d, &err) == SEM_OK, "%s", err.message);
     printf("random: %d parts, %d points, %d origins, %.4f s\n", P, N, d.n_origins, now() - t0);
+    check_against_glpk(&d, "random");
 
     /* group costs by set: recompute from the dense rows */
     double cost[60][4];
@@ -340,6 +448,7 @@ static void test_shared_models(void)
                       isfinite(d->origin_X[3 * j + 2]);
             free(used);
             CHECK(ok, "%s: bad origins", models[i]);
+            if (ok) check_against_glpk(d, models[i]);
             printf("%-36s parts %4d quad %6d  alpha %.4g nnz %.3f  origins %4d  weights %.3f s "
                    "origins %.4f s\n",
                    models[i], d->n_parts, d->n_quad, d->alpha, d->weight_nonzero_fraction,

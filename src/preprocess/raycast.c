@@ -150,6 +150,9 @@ struct sem_raycast_scene {
     struct part_node *part_nodes;
     int *part_root;           /* n_parts: root node of each part, -1 when empty */
     int *part_tri_order;      /* triangles in tree order (global indices) */
+    struct part_node *top_nodes; /* a tree over the parts' root boxes (leaves: top_order) */
+    int *top_order;           /* part indices in that tree's order */
+    int top_root;             /* -1 when no part has triangles */
     int parts_built, parts_failed;
     sem_surface *surfaces; /* copies of the parts' surfaces, for exact hit refinement */
     double lo[3], hi[3];
@@ -626,9 +629,11 @@ static int closest_parts_embree(const sem_raycast_scene *scene, const double X[3
 /* Per-part trees for closest-point queries. One Embree query over the whole scene visits
  * every triangle within the radius, which for the weights' radius alpha (often half the
  * model) is most of the model per point. Instead each part gets its own small tree of
- * axis-aligned boxes (in double); a query walks the parts in index order, skips a part
- * whose box is farther than the radius and, inside a part, shrinks its search radius to
- * the best distance so far (nearer child first): about log(triangles) work per part. */
+ * axis-aligned boxes (in double), and a tree over the parts' boxes finds the parts whose
+ * box is within the radius (a boundary sample's tiny radius meets one to three of them, so
+ * a model of many parts does not cost a box test per part and sample); those are searched in
+ * index order, each shrinking its search radius to the best distance so far (nearer child
+ * first, a child beyond it not visited): about log(triangles) work per part found. */
 #define PART_LEAF 4
 
 typedef struct part_node {
@@ -707,6 +712,43 @@ static int build_part_node(sem_raycast_scene *s, const double *centroid, int *n_
     return id;
 }
 
+/* The tree over parts: node over top_order[first .. first + count), boxes the union of the
+ * parts' root boxes, split at the median box centre along the widest axis. */
+static int build_top_node(sem_raycast_scene *s, const double *centre, int *n_nodes, int first, int count)
+{
+    int id = (*n_nodes)++;
+    part_node *node = &s->top_nodes[id];
+    int *o = s->top_order + first;
+    double clo[3], chi[3];
+    for (int d = 0; d < 3; d++) {
+        node->lo[d] = clo[d] = INFINITY;
+        node->hi[d] = chi[d] = -INFINITY;
+    }
+    for (int k = 0; k < count; k++) {
+        const part_node *r = &s->part_nodes[s->part_root[o[k]]];
+        for (int d = 0; d < 3; d++) {
+            node->lo[d] = fmin(node->lo[d], r->lo[d]);
+            node->hi[d] = fmax(node->hi[d], r->hi[d]);
+            clo[d] = fmin(clo[d], centre[3 * (size_t)o[k] + d]);
+            chi[d] = fmax(chi[d], centre[3 * (size_t)o[k] + d]);
+        }
+    }
+    node->first = first;
+    node->count = count;
+    node->left = node->right = -1;
+    if (count <= PART_LEAF) return id;
+    int axis = 0;
+    for (int d = 1; d < 3; d++)
+        if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
+    int half = count / 2;
+    select_median(o, count, centre, axis);
+    int left = build_top_node(s, centre, n_nodes, first, half);
+    int right = build_top_node(s, centre, n_nodes, first + half, count - half);
+    s->top_nodes[id].left = left;
+    s->top_nodes[id].right = right;
+    return id;
+}
+
 static int build_part_trees(sem_raycast_scene *s)
 {
     int n = s->n_triangles;
@@ -735,6 +777,32 @@ static int build_part_trees(sem_raycast_scene *s)
         s->part_root[p] = t1 > t0 ? build_part_node(s, centroid, &n_nodes, t0, t1 - t0) : -1;
     }
     free(centroid);
+    /* the tree over the parts that have triangles */
+    s->top_root = -1;
+    s->top_nodes = malloc((2 * (size_t)s->n_parts + 1) * sizeof *s->top_nodes);
+    s->top_order = malloc(((size_t)s->n_parts + 1) * sizeof *s->top_order);
+    double *centre = malloc(3 * ((size_t)s->n_parts + 1) * sizeof *centre);
+    if (!s->top_nodes || !s->top_order || !centre) {
+        free(centre);
+        free(s->top_nodes);
+        free(s->top_order);
+        free(s->part_nodes);
+        free(s->part_tri_order);
+        free(s->part_root);
+        s->top_nodes = s->part_nodes = NULL;
+        s->top_order = s->part_tri_order = s->part_root = NULL;
+        return 0;
+    }
+    int n_top = 0;
+    for (int p = 0; p < s->n_parts; p++) {
+        if (s->part_root[p] < 0) continue;
+        const part_node *r = &s->part_nodes[s->part_root[p]];
+        for (int d = 0; d < 3; d++) centre[3 * (size_t)p + d] = 0.5 * (r->lo[d] + r->hi[d]);
+        s->top_order[n_top++] = p;
+    }
+    int n_top_nodes = 0;
+    if (n_top > 0) s->top_root = build_top_node(s, centre, &n_top_nodes, 0, n_top);
+    free(centre);
     return 1;
 }
 
@@ -773,12 +841,15 @@ static int closest_in_part(const sem_raycast_scene *s, int part, const double *X
     if (root < 0) return 0;
     double best = radius, best_q[3] = {0, 0, 0};
     int best_t = -1;
+    /* nodes with their box distances (each box is measured once, when pushed) */
     int stack[128], top = 0;
+    double stack_d2[128];
+    stack_d2[top] = box_distance2(&s->part_nodes[root], X);
     stack[top++] = root;
     while (top > 0) {
-        const part_node *node = &s->part_nodes[stack[--top]];
-        double bd = box_distance2(node, X);
-        if (bd > best * best) continue;
+        --top;
+        const part_node *node = &s->part_nodes[stack[top]];
+        if (stack_d2[top] > best * best) continue;
         if (node->left < 0 || top + 2 > 128) {
             for (int k = node->first; k < node->first + node->count; k++) {
                 int t = s->part_tri_order[k];
@@ -794,20 +865,36 @@ static int closest_in_part(const sem_raycast_scene *s, int part, const double *X
                 }
             }
             if (node->left >= 0) { /* stack full (never for sane depths): finish exactly */
+                stack_d2[top] = box_distance2(&s->part_nodes[node->right], X);
                 stack[top++] = node->right;
+                stack_d2[top] = box_distance2(&s->part_nodes[node->left], X);
                 stack[top++] = node->left;
             }
             continue;
         }
         const part_node *L = &s->part_nodes[node->left], *R = &s->part_nodes[node->right];
         double dl = box_distance2(L, X), dr = box_distance2(R, X);
-        /* push the farther child first so the nearer one is searched first */
+        /* push the farther child first so the nearer one is searched first (a child beyond
+         * the best distance is not pushed at all) */
+        double b2 = best * best;
         if (dl <= dr) {
-            stack[top++] = node->right;
-            stack[top++] = node->left;
+            if (dr <= b2) {
+                stack_d2[top] = dr;
+                stack[top++] = node->right;
+            }
+            if (dl <= b2) {
+                stack_d2[top] = dl;
+                stack[top++] = node->left;
+            }
         } else {
-            stack[top++] = node->left;
-            stack[top++] = node->right;
+            if (dl <= b2) {
+                stack_d2[top] = dl;
+                stack[top++] = node->left;
+            }
+            if (dr <= b2) {
+                stack_d2[top] = dr;
+                stack[top++] = node->right;
+            }
         }
     }
     if (best_t < 0) return 0;
@@ -819,12 +906,61 @@ static int closest_in_part(const sem_raycast_scene *s, int part, const double *X
 int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3], double radius,
                               int *out_parts, double *out_dist, double *out_points)
 {
+    return sem_raycast_closest_parts_except(scene, X, radius, -1, out_parts, out_dist, out_points);
+}
+
+int sem_raycast_closest_parts_except(const sem_raycast_scene *scene, const double X[3], double radius,
+                                     int exclude, int *out_parts, double *out_dist, double *out_points)
+{
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
         return 0;
-    if (!ensure_part_trees(scene))
-        return closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points);
+    if (!ensure_part_trees(scene)) {
+        int found = closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points), n = 0;
+        for (int k = 0; k < found; ++k) {
+            if (out_parts[k] == exclude) continue;
+            out_parts[n] = out_parts[k];
+            out_dist[n] = out_dist[k];
+            if (out_points) memmove(out_points + 3 * (size_t)n, out_points + 3 * (size_t)k, 3 * sizeof(double));
+            n++;
+        }
+        return n;
+    }
+    /* the parts whose root box is within the radius, from the tree over parts, in index
+     * order (out_parts is their scratch until the results overwrite it in place) */
+    int n_cand = 0;
+    if (scene->top_root >= 0) {
+        int stack[128], top = 0;
+        stack[top++] = scene->top_root;
+        while (top > 0) {
+            const part_node *node = &scene->top_nodes[stack[--top]];
+            if (box_distance2(node, X) > radius * radius) continue;
+            if (node->left < 0 || top + 2 > 128) {
+                for (int k = node->first; k < node->first + node->count; k++) {
+                    int p = scene->top_order[k];
+                    if (p != exclude && box_distance2(&scene->part_nodes[scene->part_root[p]], X) <= radius * radius)
+                        out_parts[n_cand++] = p;
+                }
+                if (node->left >= 0) { /* stack full (never for sane depths): finish exactly */
+                    stack[top++] = node->right;
+                    stack[top++] = node->left;
+                }
+                continue;
+            }
+            stack[top++] = node->right;
+            stack[top++] = node->left;
+        }
+    }
+    for (int a = 1; a < n_cand; ++a) { /* insertion sort: few candidates */
+        int v = out_parts[a], c = a - 1;
+        while (c >= 0 && out_parts[c] > v) {
+            out_parts[c + 1] = out_parts[c];
+            --c;
+        }
+        out_parts[c + 1] = v;
+    }
     int n = 0;
-    for (int p = 0; p < scene->n_parts; p++) {
+    for (int k = 0; k < n_cand; k++) {
+        int p = out_parts[k];
         double d, q[3];
         if (!closest_in_part(scene, p, X, radius, &d, q)) continue;
         out_parts[n] = p;
@@ -1573,6 +1709,8 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->winding_tris);
     free(scene->part_nodes);
     free(scene->part_root);
+    free(scene->top_nodes);
+    free(scene->top_order);
     free(scene->part_tri_order);
     if (scene->surfaces)
         for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);

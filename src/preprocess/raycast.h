@@ -45,6 +45,10 @@ int sem_raycast_all(const sem_raycast_scene *scene, const double origin[3], cons
  * out_parts/out_dist/out_points must hold n_parts entries (points 3 each). Thread-safe. */
 int sem_raycast_closest_parts(const sem_raycast_scene *scene, const double X[3], double radius,
                               int *out_parts, double *out_dist, double *out_points);
+/* The same without part `exclude` (-1: none): a boundary sample needs only the other parts
+ * through it, and its own part's search is the most expensive one. */
+int sem_raycast_closest_parts_except(const sem_raycast_scene *scene, const double X[3], double radius,
+                                     int exclude, int *out_parts, double *out_dist, double *out_points);
 /* Generalized winding number (Jacobson et al. 2013) of the orientation-corrected
  * tessellation at X: ~1 inside, ~0 outside, fractional near open boundaries. */
 double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3]);

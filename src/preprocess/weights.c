@@ -227,7 +227,8 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
                  * the header): a tiny query radius, far cheaper than alpha */
                 const int own = own_part ? own_part[p] : -1;
                 const double query = own >= 0 ? s->on_surface : radius;
-                int found = sem_raycast_closest_parts(scene, x, query, parts, dist, points);
+                /* (its own part is added below with theta 1 whatever its distance) */
+                int found = sem_raycast_closest_parts_except(scene, x, query, own, parts, dist, points);
                 int fallback_only = 0;
                 if (found <= 0 && own < 0) {
                     /* nothing within the radius: keep only the nearest part, for the

@@ -21,6 +21,32 @@
 
 #define COVER_POINTS 8
 
+/* A quadrature point with a lower bound of its squared distance to a part. */
+typedef struct point_bound {
+    double bound;
+    int point;
+} point_bound;
+
+static int by_bound(const point_bound *x, const point_bound *y)
+{
+    if (x->bound != y->bound) return x->bound < y->bound ? -1 : 1;
+    return (x->point > y->point) - (x->point < y->point);
+}
+
+/* Squared distance from quadrature point p to the nearest boundary sample of part i. */
+static double part_distance2(const sem_discretization *d, const int *part_start, const int *part_samples, int i,
+                             int p)
+{
+    double dm = INFINITY;
+    const double *X = d->quad_X + 3 * (size_t)p;
+    for (int k = part_start[i]; k < part_start[i + 1]; ++k) {
+        const double *S = d->sample_X + 3 * (size_t)part_samples[k];
+        double dd = (X[0] - S[0]) * (X[0] - S[0]) + (X[1] - S[1]) * (X[1] - S[1]) + (X[2] - S[2]) * (X[2] - S[2]);
+        if (dd < dm) dm = dd;
+    }
+    return dm;
+}
+
 sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem_error *err)
 {
     *n_covered = 0;
@@ -49,16 +75,18 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     double *vals = malloc((cap + 1) * sizeof(double));
     double *scale = malloc((size_t)nq * sizeof(double));
     double *dist = malloc((size_t)nq * sizeof(double));
+    point_bound *near = malloc((size_t)nq * sizeof *near);
     int *best = malloc(COVER_POINTS * sizeof(int));
     /* samples grouped by part, so a missing part scans only its own */
     int *part_start = NULL, *part_samples = NULL;
     int grouped = sem_samples_by_part(d, &part_start, &part_samples);
-    if (!rows || !cols || !vals || !scale || !dist || !best || !grouped) {
+    if (!rows || !cols || !vals || !scale || !dist || !near || !best || !grouped) {
         free(rows);
         free(cols);
         free(vals);
         free(scale);
         free(dist);
+        free(near);
         free(best);
         free(seen);
         free(part_start);
@@ -70,25 +98,64 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     /* new entries first (their rows' other weights are scaled below) */
     for (int i = 0; i < np; ++i) {
         if (seen[i]) continue;
-        for (int p = 0; p < nq; ++p) {
-            double dm = INFINITY;
-            const double *X = d->quad_X + 3 * (size_t)p;
-            for (int k = part_start[i]; k < part_start[i + 1]; ++k) {
-                const double *S = d->sample_X + 3 * (size_t)part_samples[k];
-                double dd = (X[0] - S[0]) * (X[0] - S[0]) + (X[1] - S[1]) * (X[1] - S[1]) + (X[2] - S[2]) * (X[2] - S[2]);
-                if (dd < dm) dm = dd;
+        /* Distances to the part's samples, exactly for every point that can be among the
+         * COVER_POINTS nearest (those whose distance to the samples' bounding box, a lower
+         * bound, is within the upper bound below); the others get INFINITY, farther than any
+         * chosen one, so the choice is that of the exact distances. */
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int k = part_start[i]; k < part_start[i + 1]; ++k)
+            for (int e = 0; e < 3; ++e) {
+                lo[e] = fmin(lo[e], d->sample_X[3 * (size_t)part_samples[k] + e]);
+                hi[e] = fmax(hi[e], d->sample_X[3 * (size_t)part_samples[k] + e]);
             }
-            dist[p] = sqrt(dm);
+        for (int p = 0; p < nq; ++p) {
+            const double *X = d->quad_X + 3 * (size_t)p;
+            double b2 = 0;
+            for (int e = 0; e < 3; ++e) {
+                double g = X[e] < lo[e] ? lo[e] - X[e] : X[e] > hi[e] ? X[e] - hi[e] : 0;
+                b2 += g * g;
+            }
+            near[p].bound = b2;
+            near[p].point = p;
+            dist[p] = INFINITY;
         }
+        /* the COVER_POINTS points of smallest bound (partial selection), their exact
+         * distances' largest is an upper bound U of the COVER_POINTS-th distance; then
+         * every point whose bound is at most U */
         int k = nq < COVER_POINTS ? nq : COVER_POINTS;
         for (int j = 0; j < k; ++j) {
-            int b = -1;
-            for (int p = 0; p < nq; ++p) {
-                int taken = 0;
-                for (int t = 0; t < j; ++t) taken |= best[t] == p;
-                if (!taken && (b < 0 || dist[p] < dist[b])) b = p;
+            int m = j;
+            for (int p = j + 1; p < nq; ++p)
+                if (by_bound(&near[p], &near[m]) < 0) m = p;
+            point_bound t = near[j];
+            near[j] = near[m];
+            near[m] = t;
+        }
+        double U = 0;
+        int n_eval = 0; /* the evaluated points, gathered at the front of near */
+        for (int j = 0; j < k; ++j) {
+            double dm = part_distance2(d, part_start, part_samples, i, near[j].point);
+            dist[near[j].point] = sqrt(dm);
+            U = fmax(U, dm);
+            n_eval++;
+        }
+        for (int j = k; j < nq; ++j)
+            if (near[j].bound <= U) {
+                dist[near[j].point] = sqrt(part_distance2(d, part_start, part_samples, i, near[j].point));
+                near[n_eval++] = near[j];
             }
-            best[j] = b;
+        /* the k nearest: smallest distance, then lowest index */
+        for (int j = 0; j < k; ++j) {
+            int b = -1;
+            for (int e = j; e < n_eval; ++e) {
+                int p = near[e].point;
+                if (b < 0 || dist[p] < dist[near[b].point] || (dist[p] == dist[near[b].point] && p < near[b].point))
+                    b = e;
+            }
+            point_bound t = near[j];
+            near[j] = near[b];
+            near[b] = t;
+            best[j] = near[j].point;
         }
         double dmin = dist[best[0]] > 0 ? dist[best[0]] : 1e-300;
         for (int j = 0; j < k; ++j) {
@@ -123,6 +190,7 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     free(vals);
     free(scale);
     free(dist);
+    free(near);
     free(best);
     free(seen);
     free(part_start);
