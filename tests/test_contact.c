@@ -21,25 +21,11 @@
 
 #define G 9.81
 
-typedef struct setup {
-    sem_model *model;
-    sem_discretization *disc;
-    sem_world *world;
-} setup;
-
-static void setup_free(setup *s)
-{
-    sem_world_destroy(s->world);
-    sem_discretization_destroy(s->disc);
-    sem_model_destroy(s->model);
-    memset(s, 0, sizeof *s);
-}
-
 /* A rubber solid (rho 1000, E 1e6, nu 0.45), coarsely preprocessed (4 x 4 rays: the contact
  * numbers do not depend on the quadrature's resolution), in a world with the given gravity
  * and integrator, with friction mu on the object. sphere: radius 0.5 at center, else a 1 m
  * box. */
-static int make(setup *s, int sphere, const double center[3], const double gravity[3], sem_integrator integ,
+static int make(test_setup *s, int sphere, const double center[3], const double gravity[3], sem_integrator integ,
                 double mu)
 {
     memset(s, 0, sizeof *s);
@@ -85,7 +71,7 @@ static int make(setup *s, int sphere, const double center[3], const double gravi
     return id == 0;
 }
 
-static int add_plane(setup *s, double mu)
+static int add_plane(test_setup *s, double mu)
 {
     sem_error err;
     sem_collider_def cd = sem_default_collider_def();
@@ -101,10 +87,10 @@ static int add_plane(setup *s, double mu)
  * rho g h^2 / (4 E) ~ 2.5 mm, plus the spring's rest gap of ~1 mm). */
 static void test_rest(sem_integrator integ, const char *name)
 {
-    setup s;
+    test_setup s;
     const double center[3] = {0, 0, 1.0}, gravity[3] = {0, 0, -G};
     if (!make(&s, 0, center, gravity, integ, SEM_DEFAULT_FRICTION) || !add_plane(&s, SEM_DEFAULT_FRICTION)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_object_stats st;
@@ -130,17 +116,17 @@ static void test_rest(sem_integrator integ, const char *name)
     CHECK(st.kinetic_energy < 1e-3 * drop_energy, "%s: KE %g of %g", name, st.kinetic_energy, drop_energy);
     CHECK_NEAR(st.center_of_mass[2], 0.5, 0.005);
     CHECK(cs.contacts > 0, "%s: not resting on the plane", name);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 /* Without contact the same box falls through the plane: the test above can fail. */
 static void test_disabled(void)
 {
-    setup s;
+    test_setup s;
     memset(&s, 0, sizeof s);
     const double center[3] = {0, 0, 1.0}, gravity[3] = {0, 0, -G};
     if (!make(&s, 0, center, gravity, SEM_IMPLICIT_EULER, 0.5)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_world_destroy(s.world);
@@ -160,7 +146,7 @@ static void test_disabled(void)
     sem_world_object_stats(s.world, 0, &st);
     CHECK(st.center_of_mass[2] < 0, "contact disabled: the box should fall through (com z %g)",
           st.center_of_mass[2]);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 /* Number 2: the box resting on a 30-degree incline (gravity turned by 30 degrees about y, the
@@ -168,11 +154,11 @@ static void test_disabled(void)
  * mu = 0.2: it slides with a = g (sin 30 - 0.2 cos 30) = 3.206 m/s^2 (within 5 %). */
 static void test_incline(sem_integrator integ, double mu, const char *name)
 {
-    setup s;
+    test_setup s;
     const double theta = M_PI / 6;
     const double center[3] = {0, 0, 0.5 + 1e-3}, gravity[3] = {G * sin(theta), 0, -G * cos(theta)};
     if (!make(&s, 0, center, gravity, integ, mu) || !add_plane(&s, mu)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_error err;
@@ -198,7 +184,7 @@ static void test_incline(sem_integrator integ, double mu, const char *name)
         printf("%s: a = %.4f m/s^2 (Coulomb: %.4f)\n", name, a, expected);
         CHECK_REL(a, expected, 0.05);
     }
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 /* Number 4: a sphere (r = 0.5) dropped off-centre into a V-shaped valley (two 30-degree
@@ -206,10 +192,10 @@ static void test_incline(sem_integrator integ, double mu, const char *name)
  * at y = 0, z = r / cos 30, never passing through the mesh. */
 static void test_valley(void)
 {
-    setup s;
+    test_setup s;
     const double center[3] = {0, 0.3, 1.2}, gravity[3] = {0, 0, -G};
     if (!make(&s, 1, center, gravity, SEM_IMPLICIT_EULER, SEM_DEFAULT_FRICTION)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     /* 3 x 5 vertices over x in [-2, 2], y in {-2, 0, 2}, z = |y| tan 30 */
@@ -255,7 +241,7 @@ static void test_valley(void)
     CHECK_NEAR(st.center_of_mass[1], 0.0, 0.01);
     CHECK_NEAR(st.center_of_mass[2], rest_z, 0.01);
     CHECK(st.kinetic_energy < 1e-3 * st.mass * G * 0.6, "valley: still moving (KE %g J)", st.kinetic_energy);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 
@@ -267,12 +253,12 @@ static void test_valley(void)
  * start; docs/simulation.md): for it only the final energy is checked. */
 static void test_two_spheres(sem_integrator integ, const char *name)
 {
-    setup a, b;
+    test_setup a, b;
     const double ca[3] = {-0.52, 0, 0}, cb[3] = {0.52, 0.05, 0}, zero[3] = {0, 0, 0};
     const double mu0 = SEM_DEFAULT_FRICTION;
     if (!make(&a, 1, ca, zero, integ, mu0) || !make(&b, 1, cb, zero, integ, mu0)) {
-        setup_free(&a);
-        setup_free(&b);
+        test_setup_free(&a);
+        test_setup_free(&b);
         return;
     }
     /* both in a's world */
@@ -330,8 +316,8 @@ static void test_two_spheres(sem_integrator integ, const char *name)
                 s1.error_energy;
     CHECK(E1 <= E0, "%s: energy gained (%g > %g) after the impact", name, E1, E0);
     CHECK(min_gap > -0.01, "%s: penetration %g m", name, -min_gap);
-    setup_free(&a);
-    setup_free(&b);
+    test_setup_free(&a);
+    test_setup_free(&b);
 }
 
 /* The pieces against closed forms and finite differences: the friction potential's gradient

@@ -9,23 +9,9 @@
 #include "sem/simulation.h"
 #include "test_util.h"
 
-typedef struct setup {
-    sem_model *model;
-    sem_discretization *disc;
-    sem_world *world;
-} setup;
-
-static void setup_free(setup *s)
-{
-    sem_world_destroy(s->world);
-    sem_discretization_destroy(s->disc);
-    sem_model_destroy(s->model);
-    memset(s, 0, sizeof *s);
-}
-
 /* A 2 x 1 x 1 box (beam_sections 0) or a 1 x 1 x 1 m per section beam along x, preprocessed
  * with 4 x 4 rays, into s->model and s->disc. */
-static int make_model(setup *s, int beam_sections, int order, int points_per_interval)
+static int make_model(test_setup *s, int beam_sections, int order, int points_per_interval)
 {
     memset(s, 0, sizeof *s);
     sem_error err;
@@ -59,7 +45,7 @@ static int make_model(setup *s, int beam_sections, int order, int points_per_int
 }
 
 /* make_model (4 points per interval) in a world of its own */
-static int make_world(setup *s, int beam_sections, int order, const sem_world_def *wd,
+static int make_world(test_setup *s, int beam_sections, int order, const sem_world_def *wd,
                       const sem_object_def *od_in)
 {
     if (!make_model(s, beam_sections, order, 4)) return 0;
@@ -75,7 +61,7 @@ static int make_world(setup *s, int beam_sections, int order, const sem_world_de
     return id == 0;
 }
 
-static int make_box_world(setup *s, int order, const sem_world_def *wd, const sem_object_def *od_in)
+static int make_box_world(test_setup *s, int order, const sem_world_def *wd, const sem_object_def *od_in)
 {
     return make_world(s, 0, order, wd, od_in);
 }
@@ -100,9 +86,9 @@ static void test_free_fall(void)
     wd.gravity[2] = -9.81;
     wd.dt = 0.01;
     wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
-    setup s;
+    test_setup s;
     if (!make_box_world(&s, 2, &wd, NULL)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_object_stats st0, st;
@@ -116,7 +102,7 @@ static void test_free_fall(void)
     CHECK_NEAR(st.center_of_mass[0], st0.center_of_mass[0], 1e-9 * drop);
     CHECK_REL(st.linear_momentum[2], -st.mass * 9.81 * wd.dt * n, 1e-9);
     CHECK_REL(st0.volume, 2.0, 1e-12);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 /* Zero gravity: linear momentum is conserved to round-off by the linearly implicit step
@@ -131,9 +117,9 @@ static void test_momentum_and_spin(void)
     od.initial_velocity[0] = 1.0;
     od.initial_velocity[1] = -0.5;
     od.initial_angular_velocity[2] = 2.0;
-    setup s;
+    test_setup s;
     if (!make_box_world(&s, 2, &wd, &od)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_object_stats st0, st;
@@ -149,11 +135,11 @@ static void test_momentum_and_spin(void)
           "spinning body blew up: KE %g -> %g", st0.kinetic_energy, st.kinetic_energy);
     CHECK(st.kinetic_energy > 0.5 * st0.kinetic_energy, "spin died out: KE %g -> %g", st0.kinetic_energy,
           st.kinetic_energy);
-    setup_free(&s);
+    test_setup_free(&s);
 
     wd.integrator = SEM_IMPLICIT_EULER;
     if (!make_box_world(&s, 2, &wd, &od)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_world_object_stats(s.world, 0, &st0);
@@ -169,7 +155,7 @@ static void test_momentum_and_spin(void)
     }
     CHECK(ok, "implicit step failed: %s", err.message);
     CHECK(increases == 0, "total energy increased in %d implicit Euler steps", increases);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 /* Patch test (Fig. 9): every control point prescribed by an affine map; the elastic
@@ -248,9 +234,9 @@ static void test_patch(void)
 static void test_twist(void)
 {
     sem_error err;
-    setup s;
+    test_setup s;
     if (!make_model(&s, 4, 2, 8)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     sem_model *m = s.model;
@@ -304,7 +290,7 @@ static void test_twist(void)
         CHECK(mid_angle > 35 * M_PI / 180 && mid_angle < 55 * M_PI / 180, "middle section turned %g degrees",
               mid_angle * 180 / M_PI);
     }
-    setup_free(&s);
+    test_setup_free(&s);
     free(group);
     free(q0);
 }
@@ -355,7 +341,7 @@ static double spin_elastic_energy(int n_part_materials, double density_factor, d
         od.part_materials = mats;
         od.n_part_materials = 1;
     }
-    setup s;
+    test_setup s;
     int ok = make_box_world(&s, 2, &wd, &od);
     free(pm); /* the object must not need them after it is added */
     free(mats);
@@ -371,7 +357,7 @@ static double spin_elastic_energy(int n_part_materials, double density_factor, d
     } else {
         CHECK(0, "spinning box failed");
     }
-    setup_free(&s);
+    test_setup_free(&s);
     return e;
 }
 
@@ -389,7 +375,7 @@ static double *chunked_run(int chunk, size_t *n)
     od.initial_angular_velocity[2] = 3.0;
     od.material.youngs_modulus = 1e5;
     wd.advanced.assembly_chunk = chunk;
-    setup s;
+    test_setup s;
     int ok = make_box_world(&s, 2, &wd, &od);
     sem_error err;
     for (int k = 0; k < 5 && ok; ++k) ok = sem_world_step(s.world, &err) == SEM_OK;
@@ -402,7 +388,7 @@ static double *chunked_run(int chunk, size_t *n)
     } else {
         CHECK(0, "chunked box run failed");
     }
-    setup_free(&s);
+    test_setup_free(&s);
     return q;
 }
 
@@ -434,7 +420,7 @@ static void test_assembly_chunks(void)
 static void test_driven_rotation(void)
 {
     sem_error err;
-    setup s;
+    test_setup s;
     size_t nc = 0;
     double *q0 = NULL;
     int *group = NULL;
@@ -480,7 +466,7 @@ static void test_driven_rotation(void)
         CHECK(worst < 1.5e-4, "free points are up to %g m off the rigid rotation (beam width 1 m)", worst);
     }
 done:
-    setup_free(&s);
+    test_setup_free(&s);
     free(q0);
     free(group);
 }
@@ -503,9 +489,9 @@ static void test_rayleigh_momentum(void)
     od.initial_velocity[1] = -0.5;
     od.initial_velocity[2] = 0.25;
     od.initial_angular_velocity[2] = 2.0;
-    setup s;
+    test_setup s;
     if (!make_world(&s, 3, 2, &wd, &od)) {
-        setup_free(&s);
+        test_setup_free(&s);
         return;
     }
     CHECK(s.disc->n_origins > 1, "the beam has %d origin(s)", s.disc->n_origins);
@@ -521,7 +507,7 @@ static void test_rayleigh_momentum(void)
                         st0.linear_momentum[2] * st0.linear_momentum[2]);
     CHECK(pnorm > 0.5 * st0.mass, "no initial momentum (%g)", pnorm);
     for (int k = 0; k < 3; ++k) CHECK_NEAR(st.linear_momentum[k], decay * st0.linear_momentum[k], 1e-9 * pnorm);
-    setup_free(&s);
+    test_setup_free(&s);
 }
 
 static void test_part_materials(void)
@@ -560,9 +546,9 @@ static void test_rest_factor(void)
         int steps = spin ? 20 : 30;
         size_t nc = 0;
         for (int refactorize = 0; refactorize < 2; ++refactorize) {
-            setup s;
+            test_setup s;
             if (!make_model(&s, spin ? 0 : 3, 2, 4)) {
-                setup_free(&s);
+                test_setup_free(&s);
                 goto done;
             }
             nc = sem_model_control_points(s.model);
@@ -597,7 +583,7 @@ static void test_rest_factor(void)
                 memcpy(q[refactorize], sem_world_object_q(s.world, 0), 3 * nc * sizeof(double));
                 factorizations[refactorize] = sem_world_get_counters(s.world).factorizations;
             }
-            setup_free(&s);
+            test_setup_free(&s);
         }
         if (q[0] && q[1]) {
             double motion = 0, diff = 0;
@@ -639,7 +625,7 @@ static void test_counters(void)
     wd.integrator = SEM_LINEARLY_IMPLICIT_EULER;
     wd.solver = SEM_SOLVER_SPARSE;
     wd.advanced.refactorize = 1; /* (test_rest_factor: otherwise the rest factor serves) */
-    setup s;
+    test_setup s;
     if (make_box_world(&s, 2, &wd, NULL)) {
         for (int k = 0; k < 3; ++k) CHECK(sem_world_step(s.world, &err) == SEM_OK, "%s", err.message);
         sem_world_counters c = sem_world_get_counters(s.world);
@@ -647,7 +633,7 @@ static void test_counters(void)
               "linearly implicit: %ld steps, %ld factorizations, %ld Newton iterations", c.steps,
               c.factorizations, c.newton_iterations);
     }
-    setup_free(&s);
+    test_setup_free(&s);
     /* implicit Euler on a soft box, without and with the trace */
     double *q[2] = {NULL, NULL};
     size_t n = 0;
@@ -660,7 +646,7 @@ static void test_counters(void)
         sem_object_def od = sem_default_object_def();
         od.material.youngs_modulus = 1e5;
         if (!make_box_world(&s, 2, &wd, &od)) {
-            setup_free(&s);
+            test_setup_free(&s);
             break;
         }
         long iterations = 0;
@@ -681,7 +667,7 @@ static void test_counters(void)
         n = (size_t)sem_world_object_dofs(s.world, 0);
         q[trace] = malloc(n * sizeof(double));
         if (q[trace]) memcpy(q[trace], sem_world_object_q(s.world, 0), n * sizeof(double));
-        setup_free(&s);
+        test_setup_free(&s);
     }
     if (q[0] && q[1]) CHECK(memcmp(q[0], q[1], n * sizeof(double)) == 0, "the trace changed the result");
     free(q[0]);
@@ -697,7 +683,7 @@ static void test_counters(void)
  * the largest difference of a control point between the two worlds, NaN on failure. */
 static double together_difference(sem_integrator integrator, int steps)
 {
-    setup box, beam;
+    test_setup box, beam;
     int ok = make_model(&box, 0, 2, 4);
     ok = make_model(&beam, 2, 2, 4) && ok;
     size_t nc = ok ? sem_model_control_points(beam.model) : 0;
@@ -762,8 +748,8 @@ done:
     sem_world_destroy(world[1]);
     free(q0);
     free(pin);
-    setup_free(&box);
-    setup_free(&beam);
+    test_setup_free(&box);
+    test_setup_free(&beam);
     return worst;
 }
 

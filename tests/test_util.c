@@ -75,3 +75,11 @@ int test_run_cli(const char *args, char *out, size_t out_size, char *errbuf, siz
     if (rc == -1) return -1;
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
 }
+
+void test_setup_free(test_setup *s)
+{
+    sem_world_destroy(s->world);
+    sem_discretization_destroy(s->disc);
+    sem_model_destroy(s->model);
+    memset(s, 0, sizeof *s);
+}

@@ -5,6 +5,10 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "sem/model.h"
+#include "sem/preprocess.h"
+#include "sem/simulation.h"
+
 extern int test_failures;
 extern int test_checks;
 
@@ -48,5 +52,14 @@ const char *test_tmpdir(void);
 /* Runs the sem CLI with arguments; captures stdout/stderr into the given buffers
  * (may be NULL). Returns the exit status. */
 int test_run_cli(const char *args, char *out, size_t out_size, char *errbuf, size_t err_size);
+
+/* A model, its discretization and a world, for tests that build all three;
+ * test_setup_free destroys what is set and zeroes the struct. */
+typedef struct test_setup {
+    sem_model *model;
+    sem_discretization *disc;
+    sem_world *world;
+} test_setup;
+void test_setup_free(test_setup *s);
 
 #endif

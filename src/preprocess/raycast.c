@@ -672,65 +672,28 @@ static void select_median(int *o, int count, const double *centroid, int axis)
     }
 }
 
-static int build_part_node(sem_raycast_scene *s, const double *centroid, int *n_nodes, int first,
-                           int count)
+/* A tree node over items order[first .. first + count) (triangles of a part, or parts):
+ * box[6 i .. 6 i + 6) is item i's box (lo, hi), centre[3 i ..] the point it is split by: at
+ * the median along the widest extent of the centres, leaves of at most PART_LEAF items.
+ * Returns the node's index in nodes. */
+static int build_box_node(part_node *nodes, int *order, const double *box, const double *centre, int *n_nodes,
+                          int first, int count)
 {
     int id = (*n_nodes)++;
-    part_node *node = &s->part_nodes[id];
-    int *o = s->part_tri_order + first;
+    part_node *node = &nodes[id];
+    int *o = order + first;
     double clo[3], chi[3];
     for (int d = 0; d < 3; d++) {
         node->lo[d] = clo[d] = INFINITY;
         node->hi[d] = chi[d] = -INFINITY;
     }
     for (int k = 0; k < count; k++) {
-        const double *v = s->tri + 9 * (size_t)o[k];
-        for (int c = 0; c < 3; c++)
-            for (int d = 0; d < 3; d++) {
-                if (v[3 * c + d] < node->lo[d]) node->lo[d] = v[3 * c + d];
-                if (v[3 * c + d] > node->hi[d]) node->hi[d] = v[3 * c + d];
-            }
+        const double *b = box + 6 * (size_t)o[k], *c = centre + 3 * (size_t)o[k];
         for (int d = 0; d < 3; d++) {
-            double x = centroid[3 * (size_t)o[k] + d];
-            if (x < clo[d]) clo[d] = x;
-            if (x > chi[d]) chi[d] = x;
-        }
-    }
-    node->first = first;
-    node->count = count;
-    node->left = node->right = -1;
-    if (count <= PART_LEAF) return id;
-    int axis = 0;
-    for (int d = 1; d < 3; d++)
-        if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
-    int half = count / 2;
-    select_median(o, count, centroid, axis);
-    int left = build_part_node(s, centroid, n_nodes, first, half);
-    int right = build_part_node(s, centroid, n_nodes, first + half, count - half);
-    s->part_nodes[id].left = left;
-    s->part_nodes[id].right = right;
-    return id;
-}
-
-/* The tree over parts: node over top_order[first .. first + count), boxes the union of the
- * parts' root boxes, split at the median box centre along the widest axis. */
-static int build_top_node(sem_raycast_scene *s, const double *centre, int *n_nodes, int first, int count)
-{
-    int id = (*n_nodes)++;
-    part_node *node = &s->top_nodes[id];
-    int *o = s->top_order + first;
-    double clo[3], chi[3];
-    for (int d = 0; d < 3; d++) {
-        node->lo[d] = clo[d] = INFINITY;
-        node->hi[d] = chi[d] = -INFINITY;
-    }
-    for (int k = 0; k < count; k++) {
-        const part_node *r = &s->part_nodes[s->part_root[o[k]]];
-        for (int d = 0; d < 3; d++) {
-            node->lo[d] = fmin(node->lo[d], r->lo[d]);
-            node->hi[d] = fmax(node->hi[d], r->hi[d]);
-            clo[d] = fmin(clo[d], centre[3 * (size_t)o[k] + d]);
-            chi[d] = fmax(chi[d], centre[3 * (size_t)o[k] + d]);
+            if (b[d] < node->lo[d]) node->lo[d] = b[d];
+            if (b[3 + d] > node->hi[d]) node->hi[d] = b[3 + d];
+            if (c[d] < clo[d]) clo[d] = c[d];
+            if (c[d] > chi[d]) chi[d] = c[d];
         }
     }
     node->first = first;
@@ -742,66 +705,73 @@ static int build_top_node(sem_raycast_scene *s, const double *centre, int *n_nod
         if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
     int half = count / 2;
     select_median(o, count, centre, axis);
-    int left = build_top_node(s, centre, n_nodes, first, half);
-    int right = build_top_node(s, centre, n_nodes, first + half, count - half);
-    s->top_nodes[id].left = left;
-    s->top_nodes[id].right = right;
+    int left = build_box_node(nodes, order, box, centre, n_nodes, first, half);
+    int right = build_box_node(nodes, order, box, centre, n_nodes, first + half, count - half);
+    nodes[id].left = left;
+    nodes[id].right = right;
     return id;
+}
+
+static void free_part_trees(sem_raycast_scene *s)
+{
+    free(s->part_nodes);
+    free(s->part_tri_order);
+    free(s->part_root);
+    free(s->top_nodes);
+    free(s->top_order);
+    s->part_nodes = s->top_nodes = NULL;
+    s->part_tri_order = s->part_root = s->top_order = NULL;
 }
 
 static int build_part_trees(sem_raycast_scene *s)
 {
-    int n = s->n_triangles;
-    s->part_nodes = malloc((size_t)(2 * n + s->n_parts) * sizeof *s->part_nodes);
+    int n = s->n_triangles, np = s->n_parts;
+    s->part_nodes = malloc((size_t)(2 * n + np) * sizeof *s->part_nodes);
     s->part_tri_order = malloc((size_t)n * sizeof *s->part_tri_order);
-    s->part_root = malloc((size_t)s->n_parts * sizeof *s->part_root);
-    double *centroid = malloc((size_t)n * 3 * sizeof *centroid);
-    if (!s->part_nodes || !s->part_tri_order || !s->part_root || !centroid) {
-        free(centroid);
-        free(s->part_nodes);
-        free(s->part_tri_order);
-        free(s->part_root);
-        s->part_nodes = NULL;
-        s->part_tri_order = NULL;
-        s->part_root = NULL;
+    s->part_root = malloc(((size_t)np + 1) * sizeof *s->part_root);
+    s->top_nodes = malloc((2 * (size_t)np + 1) * sizeof *s->top_nodes);
+    s->top_order = malloc(((size_t)np + 1) * sizeof *s->top_order);
+    s->top_root = -1;
+    /* boxes and centres of the triangles, then of the parts */
+    size_t items = (size_t)(n > np ? n : np) + 1;
+    double *box = malloc(6 * items * sizeof *box), *centre = malloc(3 * items * sizeof *centre);
+    if (!s->part_nodes || !s->part_tri_order || !s->part_root || !s->top_nodes || !s->top_order || !box ||
+        !centre) {
+        free(box);
+        free(centre);
+        free_part_trees(s);
         return 0;
     }
     for (int t = 0; t < n; t++) {
         s->part_tri_order[t] = t;
         const double *v = s->tri + 9 * (size_t)t;
-        for (int d = 0; d < 3; d++) centroid[3 * (size_t)t + d] = (v[d] + v[3 + d] + v[6 + d]) / 3;
+        for (int d = 0; d < 3; d++) {
+            box[6 * (size_t)t + d] = fmin(fmin(v[d], v[3 + d]), v[6 + d]);
+            box[6 * (size_t)t + 3 + d] = fmax(fmax(v[d], v[3 + d]), v[6 + d]);
+            centre[3 * (size_t)t + d] = (v[d] + v[3 + d] + v[6 + d]) / 3;
+        }
     }
     int n_nodes = 0;
-    for (int p = 0; p < s->n_parts; p++) {
+    for (int p = 0; p < np; p++) {
         int t0 = s->part_tri_offset[p], t1 = s->part_tri_offset[p + 1];
-        s->part_root[p] = t1 > t0 ? build_part_node(s, centroid, &n_nodes, t0, t1 - t0) : -1;
+        s->part_root[p] = t1 > t0 ? build_box_node(s->part_nodes, s->part_tri_order, box, centre, &n_nodes, t0, t1 - t0)
+                                  : -1;
     }
-    free(centroid);
-    /* the tree over the parts that have triangles */
-    s->top_root = -1;
-    s->top_nodes = malloc((2 * (size_t)s->n_parts + 1) * sizeof *s->top_nodes);
-    s->top_order = malloc(((size_t)s->n_parts + 1) * sizeof *s->top_order);
-    double *centre = malloc(3 * ((size_t)s->n_parts + 1) * sizeof *centre);
-    if (!s->top_nodes || !s->top_order || !centre) {
-        free(centre);
-        free(s->top_nodes);
-        free(s->top_order);
-        free(s->part_nodes);
-        free(s->part_tri_order);
-        free(s->part_root);
-        s->top_nodes = s->part_nodes = NULL;
-        s->top_order = s->part_tri_order = s->part_root = NULL;
-        return 0;
-    }
+    /* the tree over the parts that have triangles (by their boxes' centres) */
     int n_top = 0;
-    for (int p = 0; p < s->n_parts; p++) {
+    for (int p = 0; p < np; p++) {
         if (s->part_root[p] < 0) continue;
         const part_node *r = &s->part_nodes[s->part_root[p]];
-        for (int d = 0; d < 3; d++) centre[3 * (size_t)p + d] = 0.5 * (r->lo[d] + r->hi[d]);
+        for (int d = 0; d < 3; d++) {
+            box[6 * (size_t)p + d] = r->lo[d];
+            box[6 * (size_t)p + 3 + d] = r->hi[d];
+            centre[3 * (size_t)p + d] = 0.5 * (r->lo[d] + r->hi[d]);
+        }
         s->top_order[n_top++] = p;
     }
     int n_top_nodes = 0;
-    if (n_top > 0) s->top_root = build_top_node(s, centre, &n_top_nodes, 0, n_top);
+    if (n_top > 0) s->top_root = build_box_node(s->top_nodes, s->top_order, box, centre, &n_top_nodes, 0, n_top);
+    free(box);
     free(centre);
     return 1;
 }
@@ -1707,11 +1677,7 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->winding_order);
     free(scene->winding_sign);
     free(scene->winding_tris);
-    free(scene->part_nodes);
-    free(scene->part_root);
-    free(scene->top_nodes);
-    free(scene->top_order);
-    free(scene->part_tri_order);
+    free_part_trees(scene);
     if (scene->surfaces)
         for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);
     free(scene->surfaces);
