@@ -65,6 +65,7 @@ static void free_disc(sem_discretization *d)
     free(d->sample_uv);
     free(d->sample_X);
     free(d->sample_area);
+    free(d->sample_seam);
     sem_csr_free(&d->J_hat);
     free(d->origin_X);
     free(d->part_origin);

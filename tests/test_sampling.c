@@ -6,6 +6,7 @@
 
 #include "sem/nurbs.h"
 #include "sem/primitives.h"
+#include "sem/refine.h"
 #include "preprocess/steps.h"
 #include "test_util.h"
 
@@ -67,6 +68,7 @@ static void discretization_free(sem_discretization *d)
     free(d->sample_uv);
     free(d->sample_X);
     free(d->sample_area);
+    free(d->sample_seam);
     sem_csr_free(&d->J_hat);
     memset(d, 0, sizeof *d);
 }
@@ -431,8 +433,52 @@ static void test_errors(void)
     sem_model_destroy(m);
 }
 
+/* The seam weight (sample_seam): a sample on a side of its part's parameter range weighs as
+ * if the part were one knot span across that side, so it does not change when the part is
+ * refined; elsewhere it is the sample's area. A unit box of biquadratic faces (one span) has
+ * seam == area everywhere; refined by 3, a sample on one side has 3 x its area, on a corner
+ * 9 x, inside 1 x. */
+static void test_seam_weights(void)
+{
+    sem_error err;
+    sem_model *box = sem_model_create(), *fine = NULL;
+    sem_box_def bd = sem_default_box_def();
+    bd.degree = 2;
+    CHECK(sem_primitive_box(box, &bd, &err) == SEM_OK, "box: %s", err.message);
+    CHECK(sem_model_refine(box, 3, &fine, &err) == SEM_OK, "refine: %s", err.message);
+    for (int r = 0; r < 2 && fine; ++r) {
+        const sem_model *m = r ? fine : box;
+        sem_discretization d;
+        memset(&d, 0, sizeof d);
+        CHECK(sem_step_sample(m, &d, &err) == SEM_OK, "%s", err.message);
+        int bad = 0, sides[3] = {0, 0, 0};
+        double seam_side = 0, area_side = 0;
+        for (int k = 0; k < d.n_samples; ++k) {
+            const sem_surface *sf = &m->parts[d.sample_part[k]].surface;
+            double u = d.sample_uv[2 * k], v = d.sample_uv[2 * k + 1];
+            int n = (u == sf->u0 || u == sf->u1) + (v == sf->v0 || v == sf->v1);
+            double want = r ? pow(3.0, n) : 1.0;
+            bad += fabs(d.sample_seam[k] - want * d.sample_area[k]) > 1e-12 * want * d.sample_area[k];
+            sides[n]++;
+            if (n == 1) {
+                seam_side += d.sample_seam[k];
+                area_side += d.sample_area[k];
+            }
+        }
+        printf("seam weights, box refined by %d: %d samples (%d inside, %d on a side, %d on a corner), "
+               "side samples weigh %.4g as seams, %.4g as areas\n", r ? 3 : 1, d.n_samples, sides[0], sides[1],
+               sides[2], seam_side, area_side);
+        CHECK(bad == 0, "refined by %d: %d samples with the wrong seam weight", r ? 3 : 1, bad);
+        CHECK(sides[1] > 0 && sides[2] > 0, "samples on sides and corners");
+        discretization_free(&d);
+    }
+    sem_model_destroy(box);
+    sem_model_destroy(fine);
+}
+
 int main(void)
 {
+    test_seam_weights();
     test_box_area_and_counts();
     test_low_degree_counts();
     test_sphere_and_cylinder_area();

@@ -415,12 +415,33 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory projecting a trim loop");
         goto done;
     }
+    /* The surface lies in the box of its control points (positive weights): a curve point
+     * farther from that box than allowed fails the loop before any point is projected (a
+     * stray curve would otherwise cost every one of its points a full inversion search) */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, apart = 0;
+    for (size_t k = 0; k < (size_t)c.s->n_u * (size_t)c.s->n_v; ++k)
+        for (int e = 0; e < 3; ++e) {
+            lo[e] = fmin(lo[e], c.s->ctrl[3 * k + e]);
+            hi[e] = fmax(hi[e], c.s->ctrl[3 * k + e]);
+        }
     double last[3];
     for (int k = 0; k < n_curves; ++k) {
         const sem_curve *cv = &curves[k];
         double a[3], b[3];
         sem_curve_eval(cv, cv->t0, a, NULL);
         sem_curve_eval(cv, cv->t1, b, NULL);
+        for (int j = 0; j <= 32; ++j) { /* 33 points along the curve, its ends included */
+            double x[3], d2 = 0;
+            if (j == 0 || j == 32)
+                memcpy(x, j ? b : a, sizeof x);
+            else
+                sem_curve_eval(cv, cv->t0 + (cv->t1 - cv->t0) * j / 32.0, x, NULL);
+            for (int e = 0; e < 3; ++e) {
+                double g = fmax(fmax(lo[e] - x[e], x[e] - hi[e]), 0);
+                d2 += g * g;
+            }
+            apart = fmax(apart, sqrt(d2));
+        }
         if (k == 0) {
             if (n_curves > 1) {
                 const sem_curve *nx = &curves[1];
@@ -436,6 +457,13 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
         memcpy(last, end, sizeof last);
     }
 
+    if (!(apart <= c.max_distance)) {
+        st = sem_error_set(err, SEM_ERR_INVALID,
+                           "a model-space boundary curve is %.3g away from its surface "
+                           "(allowed %.3g)",
+                           apart, c.max_distance);
+        goto done;
+    }
     for (int k = 0; k < n_curves; ++k) {
         const double *guess = k > 0 && chains[k - 1].n ? chains[k - 1].p[chains[k - 1].n - 1].uv
                                                         : NULL;

@@ -165,8 +165,20 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     }
     gathered = 1;
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
+    /* The prediction q_n + h v_n is the usual first iterate, but at an impact it can carry a
+     * part through the contact springs far enough to invert an element (infinite energy, no
+     * gradient). Newton then starts from q_n instead (free points where they are), which is
+     * valid: it is the last accepted state. */
+    if (dynamic && !isfinite(nonquadratic(&nt, q))) {
+        for (int k = 0; k < s->n_objects; ++k) {
+            const sem_object *o = s->objects[k];
+            size_t off = s->dof_offset[k];
+            for (int c = 0; c < o->n_ctrl; ++c)
+                if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
+        }
+    }
 
-    double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY;
+    double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0;
     int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0;
     set_exact_hessian(s, 0);
     for (it = 0; it < max_iterations; ++it) {
@@ -217,11 +229,14 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             curv += dir[i] * adir[i];
         }
         /* The Newton decrement (-slope: the decrease the step promises) below what the energy
-         * resolves: the energy cannot judge the step, but the quadratic model is exact there,
+         * resolves (1e-14 of V + Ec, or of the first iteration's decrement, the size of the
+         * solve's energy change): the energy cannot judge the step, but the quadratic model is
+         * exact there,
          * so the full step is taken, for as long as it halves the gradient. When it no longer
          * does, q is an equilibrium to round-off (a relative gradient cannot tell when the
          * first gradient is round-off itself, e.g. a static step that nothing moves). */
-        int unresolved = -slope <= 1e-14 * fabs(vc0);
+        if (it == 0) slope0 = -slope;
+        int unresolved = -slope <= 1e-14 * fmax(fabs(vc0), slope0);
         if (unresolved && gnorm >= 0.5 * prev_gnorm) {
             ++it;
             converged = 1;
