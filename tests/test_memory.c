@@ -25,18 +25,6 @@
 
 static char out_buf[1 << 16], err_buf[1 << 16];
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)(n > 0 ? n : 0) + 1);
-    if (b) b[fread(b, 1, (size_t)(n > 0 ? n : 0), f)] = '\0';
-    fclose(f);
-    return b;
-}
 
 static double num(const cJSON *o, const char *key)
 {
@@ -48,7 +36,7 @@ static cJSON *read_summary(const char *dir)
 {
     char p[1024];
     snprintf(p, sizeof p, "%s/summary.json", dir);
-    char *t = slurp(p);
+    char *t = test_slurp(p, NULL);
     cJSON *j = t ? cJSON_Parse(t) : NULL;
     free(t);
     return j;

@@ -24,19 +24,6 @@ typedef struct scene_case {
     int sanitized; /* also under the sanitizers */
 } scene_case;
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)(n > 0 ? n : 0) + 1);
-    size_t got = b ? fread(b, 1, (size_t)(n > 0 ? n : 0), f) : 0;
-    if (b) b[got] = '\0';
-    fclose(f);
-    return b;
-}
 
 /* Points every "model" of the array at the shared models folder; 0 when one is missing. */
 static int relocate_models(cJSON *array)
@@ -64,7 +51,7 @@ static void run_case(const scene_case *c, const char *tmp)
 {
     char path[1024], dir[1024], args[3072];
     snprintf(path, sizeof path, "%s/../../examples/%s.json", SEM_TEST_DATA, c->name);
-    char *text = slurp(path);
+    char *text = test_slurp(path, NULL);
     cJSON *scene = text ? cJSON_Parse(text) : NULL;
     free(text);
     CHECK(scene != NULL, "%s: cannot read %s", c->name, path);
@@ -90,7 +77,7 @@ static void run_case(const scene_case *c, const char *tmp)
     int rc = test_run_cli(args, so, sizeof so, se, sizeof se);
     CHECK(rc == 0, "%s: exit %d: %s", c->name, rc, se);
     snprintf(path, sizeof path, "%s/summary.json", dir);
-    text = slurp(path);
+    text = test_slurp(path, NULL);
     cJSON *s = text ? cJSON_Parse(text) : NULL;
     free(text);
     CHECK(s != NULL, "%s: no summary.json", c->name);

@@ -13,25 +13,11 @@
 
 static char g_out[65536], g_err[65536];
 
-static char *slurp(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)(n > 0 ? n : 0) + 1);
-    size_t got = b ? fread(b, 1, (size_t)(n > 0 ? n : 0), f) : 0;
-    if (b) b[got] = '\0';
-    fclose(f);
-    if (size) *size = got;
-    return b;
-}
 
 static int same_file(const char *a, const char *b)
 {
     size_t na, nb;
-    char *x = slurp(a, &na), *y = slurp(b, &nb);
+    char *x = test_slurp(a, &na), *y = test_slurp(b, &nb);
     int same = x && y && na == nb && memcmp(x, y, na) == 0;
     free(x);
     free(y);
@@ -42,7 +28,7 @@ static int same_file(const char *a, const char *b)
 static int png_size(const char *path, int *w, int *h)
 {
     size_t n;
-    unsigned char *b = (unsigned char *)slurp(path, &n);
+    unsigned char *b = (unsigned char *)test_slurp(path, &n);
     int ok = b && n > 24 && !memcmp(b, "\x89PNG\r\n\x1a\n", 8) && !memcmp(b + 12, "IHDR", 4);
     if (ok) {
         *w = b[16] << 24 | b[17] << 16 | b[18] << 8 | b[19];
@@ -174,7 +160,7 @@ int main(void)
         snprintf(path, sizeof path, "%s/anim.mp4", tmp);
         CHECK(run("render %s --size 64 36 --quiet --mp4 %s%s", dir, path, "") == 0, "%s", g_err);
         size_t n;
-        char *mp4 = slurp(path, &n);
+        char *mp4 = test_slurp(path, &n);
         CHECK(mp4 && n > 100 && !memcmp(mp4 + 4, "ftyp", 4), "%s is not an MP4", path);
         free(mp4);
         CHECK(tmp_files(tmp) == 0, "temporary files left in %s", tmp);
@@ -186,7 +172,7 @@ int main(void)
     CHECK(run("view %s%s%s", dir, "", "") == 0, "%s", g_err);
     snprintf(path, sizeof path, "%s/viewer.html", dir);
     size_t n = 0;
-    char *html = slurp(path, &n);
+    char *html = test_slurp(path, &n);
     CHECK(html && strstr(html, "REVISION") && strstr(html, "GLTFLoader") && strstr(html, "kinetic_energy") &&
               !strstr(html, "@SEM_") && !strstr(html, "src=\"http"),
           "viewer.html is not self-contained");

@@ -114,20 +114,6 @@ static int run_and_stop(const char *dir, int frame, int sig, const char *log_pre
     return wait_sem(pid);
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    size_t got = buf ? fread(buf, 1, (size_t)n, f) : 0;
-    fclose(f);
-    if (buf) buf[got] = '\0';
-    *len = got;
-    return buf;
-}
 
 /* Every regular file of a's folder (and its state folder) is in b with the same bytes;
  * summary.json is compared without its timings and folder names. Returns files compared. */
@@ -153,7 +139,7 @@ static int same_folder(const char *a, const char *b, const char *what)
             continue;
         }
         size_t la = 0, lb = 0;
-        char *x = slurp(pa, &la), *y = slurp(pb, &lb);
+        char *x = test_slurp(pa, &la), *y = test_slurp(pb, &lb);
         CHECK(x && y && la == lb && memcmp(x, y, la) == 0, "%s: %s differs from %s", what, pa, pb);
         free(x);
         free(y);
@@ -171,7 +157,7 @@ static void same_summary(const char *a, const char *b, const char *what)
     snprintf(pa, sizeof pa, "%s/summary.json", a);
     snprintf(pb, sizeof pb, "%s/summary.json", b);
     size_t la, lb;
-    char *x = slurp(pa, &la), *y = slurp(pb, &lb);
+    char *x = test_slurp(pa, &la), *y = test_slurp(pb, &lb);
     cJSON *ja = x ? cJSON_Parse(x) : NULL, *jb = y ? cJSON_Parse(y) : NULL;
     free(x);
     free(y);
@@ -208,7 +194,7 @@ static const char *summary_status(const char *dir, char *signal_name, size_t siz
     char path[700];
     snprintf(path, sizeof path, "%s/summary.json", dir);
     size_t len;
-    char *text = slurp(path, &len);
+    char *text = test_slurp(path, &len);
     cJSON *j = text ? cJSON_Parse(text) : NULL;
     free(text);
     const cJSON *s = j ? cJSON_GetObjectItemCaseSensitive(j, "status") : NULL;
@@ -268,7 +254,7 @@ int main(void)
     CHECK(exists(path), "animation.usda after SIGINT");
     size_t len;
     snprintf(path, sizeof path, "%s.err", log);
-    char *err = slurp(path, &len);
+    char *err = test_slurp(path, &len);
     CHECK(err && strstr(err, "interrupted by SIGINT after frame") && strstr(err, "--resume"),
           "message: %s", err ? err : "");
     free(err);
@@ -311,7 +297,7 @@ int main(void)
     if (f) fclose(f);
     rc = run_sem((const char *[]){"run", g_scene, "--out", ref, "--frames", "3", "--quiet", NULL}, log);
     snprintf(path, sizeof path, "%s.err", log);
-    err = slurp(path, &len);
+    err = test_slurp(path, &len);
     CHECK(rc == 1 && err && strstr(err, "holds another run") && strstr(err, "--overwrite"),
           "run into a used folder: exit %d: %s", rc, err ? err : "");
     free(err);
@@ -335,7 +321,7 @@ int main(void)
     mkdir(dir, 0755);
     rc = run_sem((const char *[]){"run", "--resume", dir, NULL}, log);
     snprintf(path, sizeof path, "%s.err", log);
-    err = slurp(path, &len);
+    err = test_slurp(path, &len);
     CHECK(rc == 1 && err && strstr(err, "no run to resume"), "resume of an empty folder: %s",
           err ? err : "");
     free(err);

@@ -23,27 +23,12 @@ static int exists(const char *dir, const char *name)
     return stat(p, &st) == 0 && st.st_size > 0;
 }
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)(n > 0 ? n : 0) + 1);
-    if (b) {
-        size_t got = fread(b, 1, (size_t)(n > 0 ? n : 0), f);
-        b[got] = '\0';
-    }
-    fclose(f);
-    return b;
-}
 
 static cJSON *read_summary(const char *dir)
 {
     char p[1024];
     snprintf(p, sizeof p, "%s/summary.json", dir);
-    char *t = slurp(p);
+    char *t = test_slurp(p, NULL);
     cJSON *j = t ? cJSON_Parse(t) : NULL;
     free(t);
     return j;
@@ -223,7 +208,7 @@ static void test_default_scene(const char *tmp)
     /* USD: header, one mesh, 3 time samples 0, 1, 2 */
     char path[1024];
     snprintf(path, sizeof path, "%s/animation.usda", dir);
-    char *usd = slurp(path);
+    char *usd = test_slurp(path, NULL);
     CHECK(usd != NULL, "read %s", path);
     if (usd) {
         CHECK(!strncmp(usd, "#usda 1.0", 9), "USD header");

@@ -83,3 +83,18 @@ void test_setup_free(test_setup *s)
     sem_model_destroy(s->model);
     memset(s, 0, sizeof *s);
 }
+
+char *test_slurp(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *b = malloc((size_t)(n > 0 ? n : 0) + 1);
+    size_t got = b ? fread(b, 1, (size_t)(n > 0 ? n : 0), f) : 0;
+    if (b) b[got] = '\0';
+    fclose(f);
+    if (size) *size = got;
+    return b;
+}

@@ -47,6 +47,9 @@ int test_finish(const char *name);
 /* Path of a shared model (../shared/models/..., or $SEM_SHARED_MODELS/...), or NULL when it
  * is absent; a NULL answer marks the test as skipped (test_finish). */
 const char *test_shared_model(const char *relative);
+/* The whole file at path, NUL-terminated (caller frees), its length in *size (may be NULL);
+ * NULL when it cannot be read. */
+char *test_slurp(const char *path, size_t *size);
 /* A fresh temporary directory for this test (removed by the OS / CI clean clone). */
 const char *test_tmpdir(void);
 /* Runs the sem CLI with arguments; captures stdout/stderr into the given buffers

@@ -59,15 +59,26 @@ static double dist3(const double *a, const double *b)
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-static double surface_size(const sem_surface *s)
+/* The bounding box of the surface's control points (it holds the surface: weights are
+ * positive). */
+static void control_box(const sem_surface *s, double lo[3], double hi[3])
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int d = 0; d < 3; ++d) {
+        lo[d] = INFINITY;
+        hi[d] = -INFINITY;
+    }
     size_t n = (size_t)s->n_u * (size_t)s->n_v;
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d) {
             lo[d] = fmin(lo[d], s->ctrl[3 * i + d]);
             hi[d] = fmax(hi[d], s->ctrl[3 * i + d]);
         }
+}
+
+static double surface_size(const sem_surface *s)
+{
+    double lo[3], hi[3];
+    control_box(s, lo, hi);
     double size = dist3(lo, hi);
     return size > 0 && isfinite(size) ? size : 1.0;
 }
@@ -418,12 +429,8 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
     /* The surface lies in the box of its control points (positive weights): a curve point
      * farther from that box than allowed fails the loop before any point is projected (a
      * stray curve would otherwise cost every one of its points a full inversion search) */
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, apart = 0;
-    for (size_t k = 0; k < (size_t)c.s->n_u * (size_t)c.s->n_v; ++k)
-        for (int e = 0; e < 3; ++e) {
-            lo[e] = fmin(lo[e], c.s->ctrl[3 * k + e]);
-            hi[e] = fmax(hi[e], c.s->ctrl[3 * k + e]);
-        }
+    double lo[3], hi[3], apart = 0;
+    control_box(c.s, lo, hi);
     double last[3];
     for (int k = 0; k < n_curves; ++k) {
         const sem_curve *cv = &curves[k];

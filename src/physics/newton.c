@@ -165,19 +165,6 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     }
     gathered = 1;
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
-    /* The prediction q_n + h v_n is the usual first iterate, but at an impact it can carry a
-     * part through the contact springs far enough to invert an element (infinite energy, no
-     * gradient). Newton then starts from q_n instead (free points where they are), which is
-     * valid: it is the last accepted state. */
-    if (dynamic && !isfinite(nonquadratic(&nt, q))) {
-        for (int k = 0; k < s->n_objects; ++k) {
-            const sem_object *o = s->objects[k];
-            size_t off = s->dof_offset[k];
-            for (int c = 0; c < o->n_ctrl; ++c)
-                if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
-        }
-    }
-
     double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0;
     int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0;
     set_exact_hessian(s, 0);
@@ -186,7 +173,21 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         int exact = exact_allowed && full_steps >= 2;
         set_exact_hessian(s, exact);
         double vc0 = 0;
-        if ((st = gradient(&nt, q, g, gq, &vc0, err)) != SEM_OK) goto done;
+        st = gradient(&nt, q, g, gq, &vc0, err);
+        if (st != SEM_OK && it == 0 && dynamic) {
+            /* The prediction q_n + h v_n is the usual first iterate, but at an impact it can
+             * carry a part through the contact springs far enough to invert an element
+             * (infinite energy, no gradient). Newton then starts from q_n instead (free points
+             * where they were), which is valid: it is the last accepted state. */
+            for (int k = 0; k < s->n_objects; ++k) {
+                const sem_object *o = s->objects[k];
+                size_t off = s->dof_offset[k];
+                for (int c = 0; c < o->n_ctrl; ++c)
+                    if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
+            }
+            st = gradient(&nt, q, g, gq, &vc0, err);
+        }
+        if (st != SEM_OK) goto done;
         sem_system_gather_free(s, g, fr);
         double gnorm = 0, fscale = 0;
         for (int i = 0; i < 3 * s->n_free; ++i) gnorm += fr[i] * fr[i];

@@ -847,24 +847,15 @@ static int closest_in_part(const sem_raycast_scene *s, int part, const double *X
         /* push the farther child first so the nearer one is searched first (a child beyond
          * the best distance is not pushed at all) */
         double b2 = best * best;
-        if (dl <= dr) {
-            if (dr <= b2) {
-                stack_d2[top] = dr;
-                stack[top++] = node->right;
-            }
-            if (dl <= b2) {
-                stack_d2[top] = dl;
-                stack[top++] = node->left;
-            }
-        } else {
-            if (dl <= b2) {
-                stack_d2[top] = dl;
-                stack[top++] = node->left;
-            }
-            if (dr <= b2) {
-                stack_d2[top] = dr;
-                stack[top++] = node->right;
-            }
+        int near = dl <= dr ? node->left : node->right, far = dl <= dr ? node->right : node->left;
+        double dn = fmin(dl, dr), df = dl <= dr ? dr : dl;
+        if (df <= b2) {
+            stack_d2[top] = df;
+            stack[top++] = far;
+        }
+        if (dn <= b2) {
+            stack_d2[top] = dn;
+            stack[top++] = near;
         }
     }
     if (best_t < 0) return 0;
