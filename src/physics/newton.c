@@ -36,7 +36,7 @@ typedef struct newton {
  * stiff), so evaluating it at two points and subtracting loses the few digits a converging
  * Newton step changes (measured: 1e-9 of an energy of 1 on a refined box, where a step
  * changes it by 1e-9; the search then halved the step to nothing and stalled at a relative
- * gradient of 1e-5). Its change along a step d is exact instead:
+ * gradient of 1.6e-4). Its change along a step d is exact instead:
  * Q(q + d) - Q(q) = d . grad Q(q) + 1/2 d . A d, with grad Q(q) from the gradient and A d one
  * product. */
 
