@@ -10,6 +10,12 @@
 #include "sem/nurbs.h"
 #include "sem/tessellate.h"
 
+#include "collision_topology.h"
+#include "narrow_phase.h"
+
+/* Points closer than this x the object size at rest are one point of the surface. */
+#define WELD_TOLERANCE 1e-4
+
 /* Cells per knot span so that triangle edges are at most about L / 16 (2..16). */
 static int automatic_resolution(const sem_model *model, double L, sem_error *err, int *out)
 {
@@ -32,46 +38,147 @@ static int automatic_resolution(const sem_model *model, double L, sem_error *err
     return SEM_OK;
 }
 
-/* Turns every part's triangles so that they face away from the object's inside. A part's
- * (u, v) orientation is the modeller's; the contact between objects needs outward normals.
- * Heuristic: a part whose triangles enclose a negative volume seen from the surface's
- * area centroid is turned (exact for star-shaped bodies; the preprocessing's own
- * orientation fix is not part of the discretization). */
-static void orient_parts(sem_collision_mesh *m, const sem_mesh *mesh)
+/* Signed volume of triangle t seen from centre (x 6). */
+static double triangle_volume(const sem_collision_mesh *m, int t, const double centre[3])
 {
-    double centre[3] = {0, 0, 0}, total = 0;
-    for (int t = 0; t < m->n_triangles; ++t) {
-        const int *tri = m->triangles + 3 * t;
-        for (int v = 0; v < 3; ++v) {
-            const double *x = m->x + 3 * (size_t)tri[v];
-            double a = 1.0;
-            for (int k = 0; k < 3; ++k) centre[k] += a * x[k];
-            total += a;
+    const int *tri = m->triangles + 3 * (size_t)t;
+    double a[3], b[3], c[3];
+    for (int k = 0; k < 3; ++k) {
+        a[k] = m->x[3 * (size_t)tri[0] + k] - centre[k];
+        b[k] = m->x[3 * (size_t)tri[1] + k] - centre[k];
+        c[k] = m->x[3 * (size_t)tri[2] + k] - centre[k];
+    }
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+/* 1 when triangle u runs through the welded edge a -> b in the same direction */
+static int same_direction(const sem_collision_mesh *m, int u, int a, int b)
+{
+    const int *tri = m->triangles + 3 * (size_t)u;
+    for (int v = 0; v < 3; ++v)
+        if (m->weld[tri[v]] == a && m->weld[tri[(v + 1) % 3]] == b) return 1;
+    return 0;
+}
+
+typedef struct part_link {
+    int p, q, vote; /* parts p < q sharing an edge; +1 consistent, -1 opposite */
+} part_link;
+
+static int compare_link(const void *x, const void *y)
+{
+    const part_link *a = x, *b = y;
+    if (a->p != b->p) return (a->p > b->p) - (a->p < b->p);
+    return (a->q > b->q) - (a->q < b->q);
+}
+
+/* Turns parts so that they face away from the object's inside. A part's (u, v) orientation
+ * is the modeller's; the signs of distances need outward normals. Parts that share edges
+ * are first made consistent with each other (the majority of their shared edges decides),
+ * then each group of connected parts is turned as a whole when it encloses a negative volume
+ * seen from the surface's point centroid (exact for a closed group; for a part alone it is
+ * the heuristic it always was, exact for star-shaped bodies). The preprocessing's own
+ * orientation fix is not part of the discretization. Leaves edge_other for the turned
+ * triangles. */
+static sem_status orient_parts(sem_collision_mesh *m, const sem_mesh *mesh, sem_error *err)
+{
+    int np = mesh->n_parts, nt = m->n_triangles;
+    int *tri_part = malloc(((size_t)nt + 1) * sizeof(int));
+    int *flip = malloc(((size_t)np + 1) * sizeof(int)), *group = malloc(((size_t)np + 1) * sizeof(int));
+    int *queue = malloc(((size_t)np + 1) * sizeof(int)), *first = malloc(((size_t)np + 2) * sizeof(int));
+    double *volume = calloc((size_t)np + 1, sizeof(double));
+    part_link *links = malloc((3 * (size_t)nt + 1) * sizeof *links);
+    sem_status st = SEM_OK;
+    if (!tri_part || !flip || !group || !queue || !first || !volume || !links) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collision mesh");
+        goto done;
+    }
+    if ((st = sem_collision_edge_neighbours(m->triangles, nt, m->weld, m->edge_other, err)) != SEM_OK) goto done;
+    for (int p = 0; p < np; ++p)
+        for (int t = mesh->part_triangle_start[p]; t < mesh->part_triangle_start[p + 1]; ++t) tri_part[t] = p;
+    /* the votes of the edges between parts, summed per pair of parts */
+    size_t nl = 0;
+    for (int t = 0; t < nt; ++t)
+        for (int e = 0; e < 3; ++e) {
+            int u = m->edge_other[3 * (size_t)t + (size_t)e];
+            if (u < 0 || tri_part[u] == tri_part[t] || tri_part[u] < tri_part[t]) continue;
+            int a = m->weld[m->triangles[3 * (size_t)t + (size_t)e]];
+            int b = m->weld[m->triangles[3 * (size_t)t + (size_t)(e + 1) % 3]];
+            links[nl++] = (part_link){tri_part[t], tri_part[u], same_direction(m, u, a, b) ? -1 : 1};
+        }
+    qsort(links, nl, sizeof *links, compare_link);
+    size_t nk = 0;
+    for (size_t i = 0; i < nl;) {
+        size_t j = i;
+        int vote = 0;
+        while (j < nl && links[j].p == links[i].p && links[j].q == links[i].q) vote += links[j++].vote;
+        if (vote != 0) links[nk++] = (part_link){links[i].p, links[i].q, vote > 0 ? 1 : -1};
+        i = j;
+    }
+    /* both directions of each link, grouped by part (first[p] .. first[p + 1]) */
+    part_link *adj = malloc((2 * nk + 1) * sizeof *adj);
+    if (!adj) {
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collision mesh");
+        goto done;
+    }
+    for (size_t i = 0; i < nk; ++i) {
+        adj[2 * i] = links[i];
+        adj[2 * i + 1] = (part_link){links[i].q, links[i].p, links[i].vote};
+    }
+    qsort(adj, 2 * nk, sizeof *adj, compare_link);
+    for (int p = 0, i = 0; p <= np; ++p) {
+        while ((size_t)i < 2 * nk && adj[i].p < p) ++i;
+        first[p] = i;
+    }
+    /* connected parts: relative turns by breadth-first search */
+    for (int p = 0; p < np; ++p) group[p] = -1;
+    for (int root = 0; root < np; ++root) {
+        if (group[root] >= 0) continue;
+        int head = 0, tail = 0;
+        group[root] = root;
+        flip[root] = 0;
+        queue[tail++] = root;
+        while (head < tail) {
+            int p = queue[head++];
+            for (int i = first[p]; i < first[p + 1]; ++i) {
+                int q = adj[i].q;
+                if (group[q] >= 0) continue;
+                group[q] = root;
+                flip[q] = flip[p] ^ (adj[i].vote < 0);
+                queue[tail++] = q;
+            }
         }
     }
-    if (total > 0)
-        for (int k = 0; k < 3; ++k) centre[k] /= total;
-    for (int p = 0; p < mesh->n_parts; ++p) {
-        double volume = 0;
-        int t0 = mesh->part_triangle_start[p], t1 = mesh->part_triangle_start[p + 1];
-        for (int t = t0; t < t1; ++t) {
-            const int *tri = m->triangles + 3 * t;
-            double a[3], b[3], c[3];
-            for (int k = 0; k < 3; ++k) {
-                a[k] = m->x[3 * (size_t)tri[0] + k] - centre[k];
-                b[k] = m->x[3 * (size_t)tri[1] + k] - centre[k];
-                c[k] = m->x[3 * (size_t)tri[2] + k] - centre[k];
-            }
-            volume += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
-                      a[2] * (b[0] * c[1] - b[1] * c[0]);
-        }
-        if (volume < 0)
-            for (int t = t0; t < t1; ++t) {
-                int x = m->triangles[3 * t + 1];
-                m->triangles[3 * t + 1] = m->triangles[3 * t + 2];
-                m->triangles[3 * t + 2] = x;
-            }
+    free(adj);
+    /* each group's volume with its relative turns, seen from the points' centroid */
+    double centre[3] = {0, 0, 0};
+    for (int i = 0; i < m->n_points; ++i)
+        for (int k = 0; k < 3; ++k) centre[k] += m->x[3 * (size_t)i + k];
+    for (int k = 0; k < 3 && m->n_points > 0; ++k) centre[k] /= m->n_points;
+    for (int t = 0; t < nt; ++t) {
+        int p = tri_part[t];
+        volume[group[p]] += (flip[p] ? -1 : 1) * triangle_volume(m, t, centre);
     }
+    int turned = 0;
+    for (int p = 0; p < np; ++p) {
+        if (volume[group[p]] < 0) flip[p] ^= 1;
+        if (!flip[p]) continue;
+        turned = 1;
+        for (int t = mesh->part_triangle_start[p]; t < mesh->part_triangle_start[p + 1]; ++t) {
+            int x = m->triangles[3 * t + 1];
+            m->triangles[3 * t + 1] = m->triangles[3 * t + 2];
+            m->triangles[3 * t + 2] = x;
+        }
+    }
+    if (turned) st = sem_collision_edge_neighbours(m->triangles, nt, m->weld, m->edge_other, err);
+done:
+    free(tri_part);
+    free(flip);
+    free(group);
+    free(queue);
+    free(first);
+    free(volume);
+    free(links);
+    return st;
 }
 
 void sem_collision_mesh_free(sem_collision_mesh *m)
@@ -83,6 +190,9 @@ void sem_collision_mesh_free(sem_collision_mesh *m)
     free(m->triangles);
     free(m->x);
     free(m->pseudo_normal);
+    free(m->face_normal);
+    free(m->weld);
+    free(m->edge_other);
     sem_bvh_free(&m->bvh);
     memset(m, 0, sizeof *m);
 }
@@ -143,10 +253,13 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     out->area = calloc(np, sizeof(double));
     out->x = calloc(3 * np, sizeof(double));
     out->pseudo_normal = calloc(3 * np, sizeof(double));
+    out->weld = malloc(np * sizeof(int));
+    out->face_normal = calloc(3 * (size_t)mesh.n_triangles + 1, sizeof(double));
+    out->edge_other = malloc((3 * (size_t)mesh.n_triangles + 1) * sizeof(int));
     out->n_triangles = mesh.n_triangles;
     out->triangles = malloc((3 * (size_t)mesh.n_triangles + 1) * sizeof(int));
     if (!out->row_start || !out->row_ctrl || !out->row_w || !out->area || !out->x || !out->pseudo_normal ||
-        !out->triangles)
+        !out->triangles || !out->weld || !out->face_normal || !out->edge_other)
         goto nomem;
     out->row_start[0] = 0;
     int part = 0;
@@ -165,8 +278,11 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
         out->row_start[r + 1] = start + kept;
     }
     for (int t = 0; t < 3 * mesh.n_triangles; ++t) out->triangles[t] = used[mesh.triangles[t]];
+    for (int p = 0; p < out->n_points; ++p) out->weld[p] = p;
     sem_collision_mesh_update(out, q, 0);
-    orient_parts(out, &mesh);
+    if ((st = sem_collision_weld(out->x, out->n_points, WELD_TOLERANCE * out->length, out->weld, err)) != SEM_OK ||
+        (st = orient_parts(out, &mesh, err)) != SEM_OK)
+        goto done;
     sem_collision_mesh_update(out, q, 0); /* normals of the turned triangles */
     for (int t = 0; t < out->n_triangles; ++t) {
         const int *tri = out->triangles + 3 * t;
@@ -202,14 +318,46 @@ void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int refit
         }
         memcpy(m->x + 3 * (size_t)p, x, sizeof x);
     }
+    /* face normals, and each corner's angle x normal summed at its welded point */
     memset(m->pseudo_normal, 0, 3 * (size_t)m->n_points * sizeof(double));
     for (int t = 0; t < m->n_triangles; ++t) {
         const int *tri = m->triangles + 3 * t;
-        const double *a = m->x + 3 * (size_t)tri[0], *b = m->x + 3 * (size_t)tri[1], *c = m->x + 3 * (size_t)tri[2];
-        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-        for (int v = 0; v < 3; ++v)
-            for (int k = 0; k < 3; ++k) m->pseudo_normal[3 * (size_t)tri[v] + k] += n[k];
+        const double *x[3] = {m->x + 3 * (size_t)tri[0], m->x + 3 * (size_t)tri[1], m->x + 3 * (size_t)tri[2]};
+        double e1[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
+        double e2[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+        double *n = m->face_normal + 3 * (size_t)t;
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0)) continue; /* a degenerate triangle has no direction */
+        for (int k = 0; k < 3; ++k) n[k] /= l;
+        for (int v = 0; v < 3; ++v) {
+            const double *o = x[v], *a = x[(v + 1) % 3], *b = x[(v + 2) % 3];
+            double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]}, w[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+            double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+            double angle = atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
+            double *pn = m->pseudo_normal + 3 * (size_t)m->weld[tri[v]];
+            for (int k = 0; k < 3; ++k) pn[k] += angle * n[k];
+        }
     }
+    for (int p = 0; p < m->n_points; ++p)
+        if (m->weld[p] != p) memcpy(m->pseudo_normal + 3 * (size_t)p, m->pseudo_normal + 3 * (size_t)m->weld[p],
+                                    3 * sizeof(double));
     if (refit_tree) sem_bvh_refit(&m->bvh, m->x, m->triangles);
+}
+
+void sem_collision_mesh_outward(const sem_collision_mesh *m, int t, int feature, int index, double out[3])
+{
+    const double *n = m->face_normal + 3 * (size_t)t;
+    if (feature == SEM_TRI_VERTEX) {
+        memcpy(out, m->pseudo_normal + 3 * (size_t)m->triangles[3 * (size_t)t + (size_t)index], 3 * sizeof(double));
+        return;
+    }
+    memcpy(out, n, 3 * sizeof(double));
+    if (feature == SEM_TRI_EDGE) {
+        int u = m->edge_other[3 * (size_t)t + (size_t)index];
+        if (u >= 0)
+            for (int k = 0; k < 3; ++k) out[k] += m->face_normal[3 * (size_t)u + k];
+    }
 }

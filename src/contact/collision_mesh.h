@@ -9,6 +9,11 @@
  * (phi_k f each), as point loads do. Each point carries its share of the rest surface area
  * (a third of its triangles'), which scales its contact spring. Vertices no kept triangle
  * uses (trimmed away) are dropped.
+ *
+ * Normals for the sign of a distance (collision_topology.h): points that coincide at rest
+ * (within 1e-4 of the object's size) are welded, the triangles across each edge found, and
+ * the parts turned to one orientation across their seams, so that the face, edge and
+ * angle-weighted vertex pseudonormals see one closed surface where the model is closed.
  */
 #ifndef SEM_CONTACT_COLLISION_MESH_H
 #define SEM_CONTACT_COLLISION_MESH_H
@@ -25,7 +30,10 @@ typedef struct sem_collision_mesh {
     int n_triangles;
     int *triangles;        /* 3 point indices per triangle */
     double *x;             /* current positions (sem_collision_mesh_update) */
-    double *pseudo_normal; /* current area-weighted vertex normals (outward) */
+    double *face_normal;   /* current unit triangle normals (outward) */
+    double *pseudo_normal; /* current angle-weighted vertex normals over the welded point */
+    int *weld;             /* the point's representative: points that coincide at rest */
+    int *edge_other;       /* 3 per triangle: the triangle across edge e (vertex e to e + 1), or -1 */
     double length;         /* bounding-box diagonal at rest */
     int resolution;        /* tessellation cells per knot span used */
     sem_bvh bvh;           /* over the triangles at the last update */
@@ -36,7 +44,11 @@ typedef struct sem_collision_mesh {
 sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_collision_mesh *out,
                                     sem_error *err);
 void sem_collision_mesh_free(sem_collision_mesh *m);
-/* x = J q for every point, vertex normals, and (refit_tree) the tree's boxes. */
+/* x = J q for every point, face and vertex normals, and (refit_tree) the tree's boxes. */
 void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int refit_tree);
+/* The outward direction at the closest feature of triangle t (narrow_phase.h: feature,
+ * index): its normal, the sum of the normals on either side of an edge, or the vertex's
+ * pseudonormal. */
+void sem_collision_mesh_outward(const sem_collision_mesh *m, int t, int feature, int index, double out[3]);
 
 #endif

@@ -53,6 +53,8 @@ typedef struct contact_rec {
 typedef struct friction_rec {
     int first, count;        /* weights */
     double T[6], X0[3], mu_lambda;
+    double u_last[2];
+    signed char slipping;    /* at the last iterate with a Hessian: 1, 0; -1: none yet */
 } friction_rec;
 
 struct sem_contact {
@@ -411,19 +413,8 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, reach2, &cl);
         if (t < 0) continue;
         contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
-        const int *tri = mj->triangles + 3 * t;
-        double outward[3] = {0, 0, 0};
-        if (cl.feature == SEM_TRI_FACE) {
-            const double *a = mj->x + 3 * (size_t)tri[0], *b = mj->x + 3 * (size_t)tri[1], *cc = mj->x + 3 * (size_t)tri[2];
-            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            double e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
-            outward[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            outward[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            outward[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        } else
-            for (int v = 0; v < 3; ++v)
-                if (cl.bary[v] > 0)
-                    for (int d = 0; d < 3; ++d) outward[d] += mj->pseudo_normal[3 * (size_t)tri[v] + d];
+        double outward[3];
+        sem_collision_mesh_outward(mj, t, cl.feature, cl.index, outward);
         r.d = sem_signed_distance(x, cl.point, outward, r.n);
         if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
         if (!(r.d < th + margin * radius)) continue;
@@ -567,7 +558,7 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
         return SEM_OK;
     }
     for (int i = 0; i < c->n_friction; ++i) {
-        const friction_rec *fr = &c->friction[i];
+        friction_rec *fr = &c->friction[i];
         const sem_point_weight *w = c->fweights + fr->first;
         double X[3], u[2], g[2], Hu[4];
         relative_point(s, w, fr->count, q, X);
@@ -576,6 +567,18 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
         u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
         E += sem_friction_potential(fr->mu_lambda, u, c->friction_eps, grad ? g : NULL, grad ? Hu : NULL);
         if (!grad) continue;
+        /* D's own Hessian where the contact stays sliding or sticking since the last iterate;
+         * where it changed, the Hessian of the quadratic bound, c I (friction.h) */
+        int slipping = u[0] * u[0] + u[1] * u[1] >= c->friction_eps * c->friction_eps;
+        double du = hypot(u[0] - fr->u_last[0], u[1] - fr->u_last[1]);
+        if (slipping != fr->slipping || !(du <= 0.25 * fmax(hypot(u[0], u[1]), c->friction_eps))) {
+            double curvature = sem_friction_curvature(fr->mu_lambda, u, c->friction_eps);
+            Hu[0] = Hu[3] = curvature;
+            Hu[1] = Hu[2] = 0;
+        }
+        fr->slipping = (signed char)slipping;
+        fr->u_last[0] = u[0];
+        fr->u_last[1] = u[1];
         double f[3], H[9];
         for (int a = 0; a < 3; ++a) {
             f[a] = fr->T[2 * a] * g[0] + fr->T[2 * a + 1] * g[1];
@@ -758,6 +761,7 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         sem_tangent_basis(r->n, fr->T);
         relative_point(s, w, n, q, fr->X0);
         fr->mu_lambda = r->mu * lambda;
+        fr->slipping = -1;
     }
     free(q);
     c->stats.seconds += omp_get_wtime() - t0;

@@ -53,3 +53,9 @@ void sem_tangent_basis(const double n[3], double T[6])
         T[2 * k + 1] = t2[k];
     }
 }
+
+double sem_friction_curvature(double mu_lambda, const double u[2], double eps)
+{
+    double y = sqrt(u[0] * u[0] + u[1] * u[1]);
+    return mu_lambda * (y < eps ? -y / (eps * eps) + 2 / eps : 1 / y);
+}

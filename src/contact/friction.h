@@ -18,6 +18,13 @@
 /* D(u) for mu_lambda = mu lambda; g (2) and H (2 x 2 row-major) its gradient and Hessian
  * (either may be NULL). */
 double sem_friction_potential(double mu_lambda, const double u[2], double eps, double g[2], double H[4]);
+/* mu lambda f1(|u|) / |u|: the curvature of the quadratic c |u'|^2 / 2 + const that touches
+ * D at u and lies above it everywhere (D is a concave function of |u|^2, so its tangent in
+ * |u|^2 bounds it from above). A Newton step that takes c I for D's Hessian minimizes that
+ * bound: it lowers D even where D's own Hessian has no curvature along u (sliding), which
+ * is what lets Newton cross the sticking zone, eps wide, in a few steps instead of many
+ * tiny ones (contact_world.c). */
+double sem_friction_curvature(double mu_lambda, const double u[2], double eps);
 /* Two unit vectors T = [t1 t2], 3 x 2 row-major (coordinate k of t_c at T[2 k + c]),
  * orthogonal to the unit vector n and to each other. */
 void sem_tangent_basis(const double n[3], double T[6]);

@@ -1,0 +1,26 @@
+/*
+ * collision_topology.h - the surface behind a collision mesh's separate parts (internal to
+ * src/contact/).
+ *
+ * A NURBS model is tessellated part by part, so its collision mesh is many open meshes whose
+ * boundaries meet at the parts' seams. The sign of a distance (inside or outside the other
+ * object) is read from a pseudonormal (Baerentzen and Aanaes 2005), which is right only on a
+ * closed surface: at an open boundary a point outside is called inside, at a depth of up to
+ * the search radius, and its contact energy jumps when it comes into range (the paper's
+ * astronauts failed so). Welding the points that coincide (within a tolerance: CAD models
+ * have small gaps) and finding the triangles on either side of each edge makes the seams
+ * closed again for the normals, while each point keeps its own part's row of J.
+ */
+#ifndef SEM_CONTACT_COLLISION_TOPOLOGY_H
+#define SEM_CONTACT_COLLISION_TOPOLOGY_H
+
+#include "sem/status.h"
+
+/* weld[i] = the lowest index of the points within tol of point i, transitively (x: 3 n). */
+sem_status sem_collision_weld(const double *x, int n, double tol, int *weld, sem_error *err);
+/* edge_other[3 t + e] = the triangle across edge e (from vertex e to vertex e + 1 mod 3) of
+ * triangle t, by welded ends; -1 on a boundary or where more than two triangles meet. */
+sem_status sem_collision_edge_neighbours(const int *triangles, int n_triangles, const int *weld, int *edge_other,
+                                         sem_error *err);
+
+#endif
