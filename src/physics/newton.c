@@ -166,7 +166,7 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     gathered = 1;
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
     double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0;
-    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0;
+    int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0, search_failed = 0;
     set_exact_hessian(s, 0);
     for (it = 0; it < max_iterations; ++it) {
         /* the exact Hessian after two full steps in a row (see integrators.h) */
@@ -253,6 +253,15 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
                 break;
             step *= 0.5;
         }
+        /* no step along the Newton direction lowers the energy (the potential jumps there,
+         * or the direction is not one of descent): the step is not taken, and the solve
+         * stops unconverged rather than accept a higher energy */
+        if (isfinite(dE) && !(dE <= 1e-4 * step * slope) && !unresolved && !(fabs(dE) <= 1e-14 * fabs(vc0))) {
+            if (w->def.advanced.trace_newton && w->def.log)
+                w->def.log(w->def.log_user, 0, "newton: the line search found no lower energy");
+            search_failed = 1;
+            break;
+        }
         full_steps = step == 1.0 ? full_steps + 1 : 0;
         double dmax = 0;
         for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, fabs(step * dir[i]));
@@ -281,11 +290,13 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         if (!w->def.accept_unconverged) {
             st = sem_error_set(err, SEM_ERR_NUMERIC,
                                "%s did not converge in %d Newton iterations at t = %g (relative gradient %.2g, "
-                               "tolerance %.2g): no equilibrium was found (a part free to move: unpinned, or "
-                               "zero-energy modes; or loads too large for the material); set "
-                               "integrator.accept_unconverged to keep such steps",
+                               "tolerance %.2g): %s; set integrator.accept_unconverged to keep such steps",
                                dynamic ? "the implicit Euler step" : "the static solve", it, t1, last_rel,
-                               w->def.newton_tolerance);
+                               w->def.newton_tolerance,
+                               search_failed ? "no step along Newton's direction lowered the energy (a contact "
+                                               "potential that jumps, or a Hessian far from the energy's)"
+                                             : "no equilibrium was found (a part free to move: unpinned, or "
+                                               "zero-energy modes; or loads too large for the material)");
             goto done;
         }
         w->counters.unconverged_solves++;
