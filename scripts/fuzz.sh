@@ -5,6 +5,8 @@
 #   scripts/fuzz.sh --time 600 iges obj      chosen harnesses, 10 minutes each
 #   scripts/fuzz.sh --runs 10000000 --soak   the long check: 10^7 executions per harness, one
 #                                            after the other, then the soak test (hours)
+#   --timeout S                              a unit slower than S seconds fails (default 10; on
+#                                            a loaded machine at nice 19, 30: docs/reliability.md)
 #
 # Harnesses: iges, obj, scene, cache (fuzz/fuzz_NAME.c). Seeds: fuzz/corpus/NAME plus, when
 # present, the shared models of the right kind (SEM_SHARED_MODELS, default ../shared/models)
@@ -19,14 +21,16 @@ seconds=30
 runs=0
 soak=0
 max_len=65536
+timeout=10
 names=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --time) seconds="$2"; shift 2 ;;
     --runs) runs="$2"; shift 2 ;;
     --max-len) max_len="$2"; shift 2 ;;
+    --timeout) timeout="$2"; shift 2 ;;
     --soak) soak=1; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     iges|obj|scene|cache) names+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -65,7 +69,7 @@ for n in "${names[@]}"; do
   set +e
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 OMP_NUM_THREADS=1 \
     "$build/fuzz_$n" "$corpus" "fuzz/corpus/$n" "$seeds" "${limit[@]}" \
-      -dict="fuzz/dict/$n.dict" -max_len="$max_len" -timeout=10 -rss_limit_mb=1024 \
+      -dict="fuzz/dict/$n.dict" -max_len="$max_len" -timeout="$timeout" -rss_limit_mb=1024 \
       -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$crashes/" \
       >"$log" 2>&1
   rc=$?
