@@ -58,7 +58,7 @@ static int make(test_setup *s, int sphere, const double center[3], const double 
     wd.integrator = integ;
     wd.dt = 0.01;
     wd.contact.resolution = 8;
-    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
+    wd.advanced.q_space_solvers = 1; /* the structured solver takes no contact terms yet */
     s->world = sem_world_create(&wd, &err);
     CHECK(s->world != NULL, "world: %s", err.message);
     if (!s->world) return 0;
@@ -133,7 +133,7 @@ static void test_disabled(void)
     sem_world_def wd = sem_default_world_def();
     wd.integrator = SEM_IMPLICIT_EULER;
     wd.contact.disabled = 1;
-    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
+    wd.advanced.q_space_solvers = 1; /* the structured solver takes no contact terms yet */
     sem_error err;
     s.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
@@ -253,12 +253,15 @@ static void test_valley(void)
  * start; docs/simulation.md): for it only the final energy is checked. */
 static void test_two_spheres(sem_integrator integ, const char *name)
 {
-    test_setup a, b;
-    const double ca[3] = {-0.52, 0, 0}, cb[3] = {0.52, 0.05, 0}, zero[3] = {0, 0, 0};
+    test_setup a, b, far;
+    const double ca[3] = {-0.52, 0, 0}, cb[3] = {0.52, 0.05, 0}, cf[3] = {0, 5, 0}, zero[3] = {0, 0, 0};
     const double mu0 = SEM_DEFAULT_FRICTION;
-    if (!make(&a, 1, ca, zero, integ, mu0) || !make(&b, 1, cb, zero, integ, mu0)) {
+    memset(&far, 0, sizeof far);
+    if (!make(&a, 1, ca, zero, integ, mu0) || !make(&b, 1, cb, zero, integ, mu0) ||
+        !make(&far, 1, cf, zero, integ, mu0)) {
         test_setup_free(&a);
         test_setup_free(&b);
+        test_setup_free(&far);
         return;
     }
     /* both in a's world */
@@ -268,7 +271,7 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     wd.gravity[2] = 0;
     wd.integrator = integ;
     wd.contact.resolution = 8;
-    wd.advanced.solve_together = 1; /* q-space solvers: the structured one takes no contact terms yet */
+    wd.advanced.q_space_solvers = 1; /* the structured solver takes no contact terms yet */
     a.world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
     od.model = a.model;
@@ -280,13 +283,19 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     od.disc = b.disc;
     od.initial_velocity[0] = -1.0;
     CHECK(sem_world_add_object(a.world, &od, &err) == 1, "%s", err.message);
-    sem_object_stats s0, s1;
+    /* a third sphere at rest 5 m away: an island of its own (solved apart; the pair may split
+     * into two islands again once it has rebounded far enough) */
+    od.model = far.model;
+    od.disc = far.disc;
+    od.initial_velocity[0] = 0;
+    CHECK(sem_world_add_object(a.world, &od, &err) == 2, "%s", err.message);
+    sem_object_stats s0, s1, s2;
     sem_world_object_stats(a.world, 0, &s0);
     sem_world_object_stats(a.world, 1, &s1);
     double E0 = s0.kinetic_energy + s1.kinetic_energy + s0.elastic_energy + s1.elastic_energy + s0.error_energy +
                 s1.error_energy;
-    double mv = s0.mass * 1.0, min_gap = INFINITY, max_momentum = 0, max_energy = 0;
-    int touched = 0;
+    double mv = s0.mass * 1.0, min_gap = INFINITY, max_momentum = 0, max_energy = 0, far_momentum = 0;
+    int touched = 0, islands_wrong = 0;
     for (int i = 0; i < 60; ++i) {
         if (sem_world_step(a.world, &err) != SEM_OK) {
             CHECK(0, "%s step %d: %s", name, i, err.message);
@@ -296,6 +305,10 @@ static void test_two_spheres(sem_integrator integ, const char *name)
         sem_world_contact_stats(a.world, &cs);
         if (cs.min_gap < min_gap) min_gap = cs.min_gap;
         if (cs.contacts > 0) touched = 1;
+        sem_world_counters counters = sem_world_get_counters(a.world);
+        if (counters.systems < 2) islands_wrong++;
+        sem_world_object_stats(a.world, 2, &s2);
+        for (int k = 0; k < 3; ++k) far_momentum = fmax(far_momentum, fabs(s2.linear_momentum[k]));
         sem_world_object_stats(a.world, 0, &s0);
         sem_world_object_stats(a.world, 1, &s1);
         for (int k = 0; k < 3; ++k)
@@ -307,7 +320,13 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     printf("%s: velocities after %+.3f %+.3f m/s, |total momentum| <= %.3g (m v = %.4g), energy max %.4g of %.4g, "
            "min gap %.3g m\n",
            name, va, vb, max_momentum, mv, max_energy, E0, min_gap);
+    printf("%s: islands: %ld regrouping(s), %d step(s) in fewer than 2 systems, the far sphere's momentum <= %.3g\n",
+           name, sem_world_get_counters(a.world).regroupings, islands_wrong, far_momentum);
     CHECK(touched, "%s: never touched", name);
+    CHECK(islands_wrong == 0, "%s: %d steps did not solve the pair and the far sphere apart", name, islands_wrong);
+    CHECK(sem_world_get_counters(a.world).regroupings >= 1, "%s: %ld regroupings", name,
+          sem_world_get_counters(a.world).regroupings);
+    CHECK(far_momentum <= 1e-9 * mv, "%s: the far sphere moved (momentum %g)", name, far_momentum);
     CHECK(max_momentum <= 1e-6 * mv, "%s: momentum %g", name, max_momentum);
     CHECK(va < 0 && vb > 0, "%s: no rebound (%g, %g)", name, va, vb);
     if (integ == SEM_IMPLICIT_EULER)
@@ -318,6 +337,7 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     CHECK(min_gap > -0.01, "%s: penetration %g m", name, -min_gap);
     test_setup_free(&a);
     test_setup_free(&b);
+    test_setup_free(&far);
 }
 
 /* The pieces against closed forms and finite differences: the friction potential's gradient

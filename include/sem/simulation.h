@@ -46,9 +46,11 @@ typedef struct sem_world_advanced {
     int projected_hessian; /* 1: Newton keeps the PSD-projected Hessian throughout; 0: it
                               switches to the exact one once two steps in a row are full */
     int trace_newton;      /* 1: one log line per Newton iteration */
-    int solve_together;    /* 1: every object in one linear system (what contact will need;
-                              objects do not interact yet, so the motion is the same up to
-                              round-off and Newton's joint stopping test) */
+    int solve_together;    /* 1: every object in one linear system at every step; 0: with
+                              contact between objects, one system per island (objects that
+                              may touch within the step), without, one per object */
+    int q_space_solvers;   /* 1: the sparse or dense solver, never the structured one (a
+                              world with contact: its terms go into the q-space matrix) */
     int refactorize;       /* 1: the linearly implicit step factorizes its matrix every step
                               (the paper's way); 0 (default): it reuses the rest matrix's
                               factor while the stiffness stays near its rest value
@@ -233,6 +235,9 @@ typedef struct sem_world_counters {
                                      definite, so that went back to the projected one */
     long unconverged_solves;      /* Newton solves kept without reaching the tolerance
                                      (sem_world_def.accept_unconverged) */
+    long regroupings;             /* times the objects were put in new systems because the
+                                     islands of objects that may touch changed */
+    int systems;                  /* linear systems the last step solved (one per island) */
 } sem_world_counters;
 
 sem_world_counters sem_world_get_counters(const sem_world *world);

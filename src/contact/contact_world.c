@@ -683,7 +683,6 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
                                   sem_error *err)
 {
     const sem_system *s = *system;
-    c->stats.seconds = 0;
     c->n_friction = 0;
     c->n_fweights = 0;
     c->friction_eps = 0;
@@ -816,17 +815,84 @@ done:
     return st;
 }
 
-void sem_contact_end_step(sem_contact *c, const sem_system *s)
+void sem_contact_begin_world_step(sem_contact *c)
 {
+    c->stats.seconds = 0;
     c->stats.contacts = 0;
     c->stats.min_gap = INFINITY;
+}
+
+static int find_root(int *parent, int i)
+{
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n, double h, int *island,
+                               sem_error *err)
+{
+    double t0 = omp_get_wtime();
+    double *box = malloc(6 * (size_t)n * sizeof(double) + 1);
+    if (!box) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < n; ++i) {
+        island[i] = i;
+        int ci = -1;
+        for (int k = 0; k < c->n_objects && ci < 0; ++k)
+            if (c->objects[k].object == objects[i]) ci = k;
+        sem_status st = ci < 0 ? sem_error_set(err, SEM_ERR_INVALID, "contact: an object is not in the world")
+                               : mesh_for(c, ci, err);
+        if (st != SEM_OK) {
+            free(box);
+            return st;
+        }
+        const contact_object *co = &c->objects[ci];
+        const sem_object *o = objects[i];
+        double *b = box + 6 * (size_t)i, speed2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            b[k] = INFINITY;
+            b[3 + k] = -INFINITY;
+        }
+        for (int p = 0; p < o->n_ctrl; ++p) {
+            const double *x = o->q + 3 * (size_t)p, *v = o->v + 3 * (size_t)p;
+            for (int k = 0; k < 3; ++k) {
+                b[k] = fmin(b[k], x[k]);
+                b[3 + k] = fmax(b[3 + k], x[k]);
+            }
+            speed2 = fmax(speed2, dot3(v, v));
+        }
+        double grow = 3 * (co->thickness + SEARCH_DEPTH * co->length) + fabs(h) * sqrt(speed2);
+        for (int k = 0; k < 3; ++k) {
+            b[k] -= grow;
+            b[3 + k] += grow;
+        }
+    }
+    for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) {
+            const double *a = box + 6 * (size_t)i, *b = box + 6 * (size_t)j;
+            int overlap = 1;
+            for (int k = 0; k < 3; ++k) overlap &= a[k] <= b[3 + k] && b[k] <= a[3 + k];
+            if (!overlap) continue;
+            int ri = find_root(island, i), rj = find_root(island, j);
+            if (ri < rj)
+                island[rj] = ri;
+            else if (rj < ri)
+                island[ri] = rj;
+        }
+    for (int i = 0; i < n; ++i) island[i] = find_root(island, i);
+    free(box);
+    c->stats.seconds += omp_get_wtime() - t0;
+    return SEM_OK;
+}
+
+void sem_contact_end_step(sem_contact *c, const sem_system *s)
+{
     if (!sem_contact_active(c)) return;
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     sem_error err;
     if (q && detect(c, s, q, 0, &err) == SEM_OK) {
-        c->stats.contacts = c->n_recs;
-        c->stats.min_gap = c->min_gap;
+        c->stats.contacts += c->n_recs;
+        c->stats.min_gap = fmin(c->stats.min_gap, c->min_gap);
     }
     free(q);
     c->stats.seconds += omp_get_wtime() - t0;

@@ -49,6 +49,14 @@ int sem_contact_between_objects(const sem_contact *c);
 /* 1 when anything can touch (colliders, or contact between objects). */
 int sem_contact_active(const sem_contact *c);
 
+/* Islands: island[i] = the lowest index of the objects (objects[0..n), each in the world)
+ * that object i may touch within a step of h, transitively: their control points' boxes
+ * (which hold their surfaces), widened by three search radii and by h times their fastest
+ * control point's speed, overlap. Objects of different islands are solved apart. */
+sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n, double h, int *island,
+                               sem_error *err);
+/* Starts a world step: the statistics (contacts, min_gap, seconds) sum over its systems. */
+void sem_contact_begin_world_step(sem_contact *c);
 /* Also makes the system again (solver: its choice) when objects came near each other and
  * its pattern lacks the coupling blocks their contact needs: *s may change. */
 sem_status sem_contact_begin_step(sem_contact *c, sem_system **s, double h, sem_solver_choice solver,

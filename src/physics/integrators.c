@@ -310,6 +310,10 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
     w->last_factor_s = 0;
     w->last_iterations = 0;
     double h = w->def.dt, t1 = w->time + h;
+    sem_contact_begin_world_step(w->contact);
+    /* objects that may touch in this step are solved together, the others apart */
+    sem_status rs = sem_world_regroup(w, w->def.integrator == SEM_STATIC ? 0.0 : h, err);
+    if (rs != SEM_OK) return rs;
     for (int i = 0; i < w->n_systems; ++i) {
         /* contact: friction lagged at q_n, coupling blocks between objects near each other
          * (contact_world.h; may make the system again) */
@@ -340,6 +344,9 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
 sem_status sem_world_solve_static(sem_world *w, sem_error *err)
 {
     int max_iterations = w->def.newton_max_iterations < 200 ? 200 : w->def.newton_max_iterations;
+    sem_contact_begin_world_step(w->contact);
+    sem_status rs = sem_world_regroup(w, 0.0, err);
+    if (rs != SEM_OK) return rs;
     for (int i = 0; i < w->n_systems; ++i) {
         sem_status st = sem_contact_begin_step(w->contact, &w->systems[i], 0.0, w->def.solver, err);
         if (st == SEM_OK) st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);

@@ -164,6 +164,8 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         }
     }
     gathered = 1;
+    double qscale = 0;
+    for (size_t i = 0; i < n; ++i) qscale = fmax(qscale, fabs(q[i]));
     const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
     double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0;
     int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0, search_failed = 0;
@@ -277,8 +279,11 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             goto done;
         }
         memcpy(q, qtry, n * sizeof(double));
-        /* stalled at round-off: the energy cannot decrease any more */
-        if (dmax <= 1e-14 * (1.0 + fabs(q[0]))) {
+        /* stalled at round-off: the energy cannot decrease any more; or a full Newton step
+         * (the quadratic model trusted) that moves no coordinate by more than 1e-13 of the
+         * largest: q is the solution to the round-off of q itself (an object at rest with
+         * nothing acting on it, whose gradient is round-off from its first iteration) */
+        if (dmax <= 1e-14 * (1.0 + fabs(q[0])) || (step == 1.0 && dmax <= 1e-13 * qscale)) {
             ++it;
             converged = 1;
             break;

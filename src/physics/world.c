@@ -172,7 +172,8 @@ int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_part
 {
     size_t r0 = (size_t)n_parts * (size_t)n_basis;
     return def->solver == SEM_SOLVER_STRUCTURED ||
-           (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && n_ctrl >= 2 * r0 &&
+           (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && !def->advanced.q_space_solvers &&
+            n_ctrl >= 2 * r0 &&
             3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS);
 }
 
@@ -374,6 +375,58 @@ fail:
     return -1;
 }
 
+sem_status sem_world_regroup(sem_world *w, double h, sem_error *err)
+{
+    int n = w->n_objects;
+    if (n < 2 || w->def.advanced.solve_together || !sem_contact_between_objects(w->contact)) return SEM_OK;
+    int *island = malloc(2 * (size_t)n * sizeof(int)), *current = island + n;
+    if (!island) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_status st = sem_contact_islands(w->contact, w->objects, n, h, island, err);
+    /* the grouping now: each object's label is the lowest world index in its system */
+    int same = 1;
+    for (int i = 0; i < n && st == SEM_OK; ++i) {
+        current[i] = i;
+        for (int j = 0; j < i; ++j)
+            if (w->objects[j]->system == w->objects[i]->system) {
+                current[i] = j;
+                break;
+            }
+        same &= current[i] == island[i];
+    }
+    if (st != SEM_OK || same) {
+        free(island);
+        return st;
+    }
+    /* new systems, one per island in the order of their first objects */
+    sem_system **systems = calloc((size_t)n, sizeof *systems);
+    sem_object **members = malloc((size_t)n * sizeof *members);
+    int n_systems = 0;
+    if (!systems || !members) st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int i = 0; i < n && st == SEM_OK; ++i) {
+        if (island[i] != i) continue;
+        int m = 0;
+        for (int j = i; j < n; ++j)
+            if (island[j] == i) members[m++] = w->objects[j];
+        st = sem_system_create(members, m, w->def.solver, &systems[n_systems], err);
+        if (st == SEM_OK) n_systems++;
+    }
+    if (st == SEM_OK) {
+        for (int i = 0; i < w->n_systems; ++i) sem_system_destroy(w->systems[i]);
+        memcpy(w->systems, systems, (size_t)n_systems * sizeof *systems);
+        w->n_systems = n_systems;
+        w->counters.regroupings++;
+    } else {
+        for (int i = 0; i < n_systems; ++i) sem_system_destroy(systems[i]);
+        /* the objects point to the systems they had */
+        for (int i = 0; i < w->n_systems; ++i)
+            for (int k = 0; k < w->systems[i]->n_objects; ++k) w->systems[i]->objects[k]->system = w->systems[i];
+    }
+    free(systems);
+    free(members);
+    free(island);
+    return st;
+}
+
 int sem_world_add_collider(sem_world *w, const sem_collider_def *def, sem_error *err)
 {
     if (sem_contact_add_collider(w->contact, def, err) != SEM_OK) return -1;
@@ -399,7 +452,12 @@ const double *sem_world_object_velocity(const sem_world *w, int i) { return w->o
 double sem_world_last_step_seconds(const sem_world *w) { return w->last_step_s; }
 double sem_world_last_factor_seconds(const sem_world *w) { return w->last_factor_s; }
 int sem_world_last_iterations(const sem_world *w) { return w->last_iterations; }
-sem_world_counters sem_world_get_counters(const sem_world *w) { return w->counters; }
+sem_world_counters sem_world_get_counters(const sem_world *w)
+{
+    sem_world_counters c = w->counters;
+    c.systems = w->n_systems;
+    return c;
+}
 
 const char *sem_world_solver_name(const sem_world *w, int i)
 {

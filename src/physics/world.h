@@ -24,4 +24,9 @@ struct sem_world {
     struct sem_contact *contact; /* colliders, collision meshes, friction (contact_world.h) */
 };
 
+/* Islands (contact between objects, not solve_together): the world's systems become one per
+ * group of objects that may touch within a step of h (sem_contact_islands), made again only
+ * when the groups change. Objects keep their world order within a system. */
+sem_status sem_world_regroup(sem_world *w, double h, sem_error *err);
+
 #endif
