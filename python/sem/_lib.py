@@ -116,7 +116,8 @@ class sem_object_stats(Structure):
 class sem_world_advanced(Structure):
     _c_header_ = "simulation.h"
     _fields_ = [("assembly_chunk", c_int), ("projected_hessian", c_int),
-                ("trace_newton", c_int), ("solve_together", c_int), ("refactorize", c_int)]
+                ("trace_newton", c_int), ("solve_together", c_int), ("q_space_solvers", c_int),
+                ("refactorize", c_int)]
 
 
 class sem_contact_def(Structure):
