@@ -340,6 +340,39 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     test_setup_free(&far);
 }
 
+/* Friction's bounded Hessian (friction.h, sem_friction_curvature): the quadratic
+ * D(u) + g . d + c |d|^2 / 2 with c = mu lambda f1(|u|)/|u| lies above D(u + d) for every d
+ * (D is a concave function of |u|^2), from inside and outside the sticking zone and across
+ * it, and c is at least the exact Hessian's curvature along u. On 2,000 random pairs. */
+static void test_friction_bound(void)
+{
+    const double eps = 1e-3, mul = 2.5;
+    unsigned long long x = 12345;
+    int above = 0, curv = 0;
+    double worst = 0;
+    for (int i = 0; i < 2000; ++i) {
+        double r[4];
+        for (int k = 0; k < 4; ++k) {
+            x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+            r[k] = ((double)(x >> 11) / 9007199254740992.0 - 0.5) * 6 * eps;
+        }
+        double u[2] = {r[0], r[1]}, d[2] = {r[2], r[3]}, g[2], H[4], un[2] = {u[0] + d[0], u[1] + d[1]};
+        double D = sem_friction_potential(mul, u, eps, g, H);
+        double c = sem_friction_curvature(mul, u, eps);
+        double bound = D + g[0] * d[0] + g[1] * d[1] + 0.5 * c * (d[0] * d[0] + d[1] * d[1]);
+        double Dn = sem_friction_potential(mul, un, eps, NULL, NULL);
+        worst = fmax(worst, Dn - bound);
+        above += Dn <= bound + 1e-15 * mul * eps;
+        double y2 = u[0] * u[0] + u[1] * u[1];
+        double radial = (u[0] * (H[0] * u[0] + H[1] * u[1]) + u[1] * (H[2] * u[0] + H[3] * u[1])) / y2;
+        curv += c >= radial * (1 - 1e-12);
+    }
+    printf("friction bound: above the potential at %d of 2000 random steps (worst excess %.3g), curvature >= the "
+           "exact radial one at %d\n", above, worst, curv);
+    CHECK(above == 2000, "the bound is below the friction potential at %d steps", 2000 - above);
+    CHECK(curv == 2000, "the bound's curvature is below the exact one at %d points", 2000 - curv);
+}
+
 /* The pieces against closed forms and finite differences: the friction potential's gradient
  * and Hessian (inside and outside the smoothing zone), its Coulomb limit, the closest point
  * of a triangle in each region. */
@@ -502,6 +535,7 @@ int main(int argc, char **argv)
         execv("/proc/self/exe", argv);
     }
     test_pieces();
+    test_friction_bound();
     test_scene();
     test_rest(SEM_IMPLICIT_EULER, "rest (implicit Euler)");
     test_rest(SEM_LINEARLY_IMPLICIT_EULER, "rest (linearly implicit Euler)");
