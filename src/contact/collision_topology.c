@@ -5,14 +5,17 @@
  * Welding: points are put in cells of size tol (a grid), sorted by cell; every point is
  * compared with the points of its cell and the 26 around it (binary search for each), so
  * the cost is O(n log n) for any shape, also for the many points of a flat face that share
- * one coordinate. Groups are joined by union-find; a group's representative is its lowest
- * index, so the result does not depend on the order of the comparisons.
+ * one coordinate. Groups are joined by union-find (util/union_find.h); a group's
+ * representative is its lowest index, so the result does not depend on the order of the
+ * comparisons.
  */
 #include "collision_topology.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "util/union_find.h"
 
 typedef struct cell_point {
     long long cell[3];
@@ -31,25 +34,6 @@ static int compare_cell_point(const void *x, const void *y)
     const cell_point *a = x, *b = y;
     int c = compare_cell(a->cell, b->cell);
     return c ? c : (a->point > b->point) - (a->point < b->point);
-}
-
-static int find(int *parent, int i)
-{
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
-static void join(int *parent, int a, int b)
-{
-    a = find(parent, a);
-    b = find(parent, b);
-    if (a < b)
-        parent[b] = a;
-    else if (b < a)
-        parent[a] = b;
 }
 
 /* first index of sorted[0..n) whose cell is not below key */
@@ -94,22 +78,18 @@ sem_status sem_collision_weld(const double *x, int n, double tol, int *weld, sem
                         const double *xj = x + 3 * (size_t)j;
                         double d2 = (xi[0] - xj[0]) * (xi[0] - xj[0]) + (xi[1] - xj[1]) * (xi[1] - xj[1]) +
                                     (xi[2] - xj[2]) * (xi[2] - xj[2]);
-                        if (d2 <= tol2) join(weld, i, j);
+                        if (d2 <= tol2) sem_uf_unite(weld, i, j);
                     }
                 }
     }
-    for (int i = 0; i < n; ++i) weld[i] = find(weld, i);
+    for (int i = 0; i < n; ++i) weld[i] = sem_uf_find(weld, i);
     free(sorted);
     return SEM_OK;
 }
 
-typedef struct edge_slot {
-    int a, b, slot; /* welded ends a < b; slot = 3 triangle + edge */
-} edge_slot;
-
-static int compare_edge_slot(const void *x, const void *y)
+int sem_compare_edge_slot(const void *x, const void *y)
 {
-    const edge_slot *p = x, *q = y;
+    const sem_edge_slot *p = x, *q = y;
     if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
     if (p->b != q->b) return (p->b > q->b) - (p->b < q->b);
     return (p->slot > q->slot) - (p->slot < q->slot);
@@ -120,16 +100,16 @@ sem_status sem_collision_edge_neighbours(const int *triangles, int n_triangles, 
 {
     size_t ne = 3 * (size_t)n_triangles;
     for (size_t e = 0; e < ne; ++e) edge_other[e] = -1;
-    edge_slot *edges = malloc((ne + 1) * sizeof *edges);
+    sem_edge_slot *edges = malloc((ne + 1) * sizeof *edges);
     if (!edges) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collision mesh");
     size_t m = 0;
     for (size_t e = 0; e < ne; ++e) {
         int t = (int)(e / 3), v = (int)(e % 3);
         int a = weld[triangles[3 * (size_t)t + (size_t)v]], b = weld[triangles[3 * (size_t)t + (size_t)(v + 1) % 3]];
         if (a == b) continue; /* a collapsed edge (a pole) */
-        edges[m++] = (edge_slot){a < b ? a : b, a < b ? b : a, (int)e};
+        edges[m++] = (sem_edge_slot){a < b ? a : b, a < b ? b : a, (int)e};
     }
-    qsort(edges, m, sizeof *edges, compare_edge_slot);
+    qsort(edges, m, sizeof *edges, sem_compare_edge_slot);
     for (size_t i = 0; i < m;) {
         size_t j = i;
         while (j < m && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;

@@ -16,6 +16,13 @@
 
 #include "sem/status.h"
 
+/* A triangle edge by its ends (a < b) and its slot 3 t + e; sorted by sem_compare_edge_slot
+ * (a, then b, then slot), the triangles on one edge come together. */
+typedef struct sem_edge_slot {
+    int a, b, slot;
+} sem_edge_slot;
+int sem_compare_edge_slot(const void *x, const void *y);
+
 /* weld[i] = the lowest index of the points within tol of point i, transitively (x: 3 n). */
 sem_status sem_collision_weld(const double *x, int n, double tol, int *weld, sem_error *err);
 /* edge_other[3 t + e] = the triangle across edge e (from vertex e to vertex e + 1 mod 3) of

@@ -10,8 +10,10 @@
 #include <string.h>
 
 #include "collision_mesh.h"
+#include "collision_topology.h"
 #include "friction.h"
 #include "penalty.h"
+#include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
 #define KAPPA 1000.0
@@ -147,18 +149,6 @@ static void normalize3(double a[3])
         for (int k = 0; k < 3; ++k) a[k] /= l;
 }
 
-typedef struct edge_key {
-    int a, b, slot; /* vertices a < b; slot = 3 triangle + edge */
-} edge_key;
-
-static int compare_edge(const void *x, const void *y)
-{
-    const edge_key *p = x, *q = y;
-    if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
-    if (p->b != q->b) return (p->b > q->b) - (p->b < q->b);
-    return (p->slot > q->slot) - (p->slot < q->slot);
-}
-
 /* Face, edge and vertex pseudonormals of a collider mesh: the sign of the distance to a
  * closed (or terrain-like) mesh is that of (p - c) . pseudonormal at the closest feature. */
 static sem_status mesh_normals(collider *k, sem_error *err)
@@ -167,7 +157,7 @@ static sem_status mesh_normals(collider *k, sem_error *err)
     k->face_normal = calloc(3 * nt + 1, sizeof(double));
     k->edge_normal = calloc(9 * nt + 1, sizeof(double));
     k->vertex_normal = calloc(3 * (size_t)k->n_vertices + 1, sizeof(double));
-    edge_key *edges = malloc((3 * nt + 1) * sizeof *edges);
+    sem_edge_slot *edges = malloc((3 * nt + 1) * sizeof *edges);
     if (!k->face_normal || !k->edge_normal || !k->vertex_normal || !edges) {
         free(edges);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collider");
@@ -199,10 +189,10 @@ static sem_status mesh_normals(collider *k, sem_error *err)
             double angle = acos(cosang < -1 ? -1 : cosang > 1 ? 1 : cosang);
             for (int d = 0; d < 3; ++d) k->vertex_normal[3 * (size_t)tri[v] + d] += angle * n[d];
             int p = tri[v], q = tri[(v + 1) % 3];
-            edges[3 * t + (size_t)v] = (edge_key){p < q ? p : q, p < q ? q : p, (int)(3 * t) + v};
+            edges[3 * t + (size_t)v] = (sem_edge_slot){p < q ? p : q, p < q ? q : p, (int)(3 * t) + v};
         }
     }
-    qsort(edges, 3 * nt, sizeof *edges, compare_edge);
+    qsort(edges, 3 * nt, sizeof *edges, sem_compare_edge_slot);
     for (size_t i = 0; i < 3 * nt;) {
         size_t j = i;
         double sum[3] = {0, 0, 0};
@@ -570,8 +560,8 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
         /* D's own Hessian where the contact stays sliding or sticking since the last iterate;
          * where it changed, the Hessian of the quadratic bound, c I (friction.h) */
         int slipping = u[0] * u[0] + u[1] * u[1] >= c->friction_eps * c->friction_eps;
-        double du = hypot(u[0] - fr->u_last[0], u[1] - fr->u_last[1]);
-        if (slipping != fr->slipping || !(du <= 0.25 * fmax(hypot(u[0], u[1]), c->friction_eps))) {
+        if (slipping != fr->slipping || /* (u_last is set once slipping is) */
+            !(hypot(u[0] - fr->u_last[0], u[1] - fr->u_last[1]) <= 0.25 * fmax(hypot(u[0], u[1]), c->friction_eps))) {
             double curvature = sem_friction_curvature(fr->mu_lambda, u, c->friction_eps);
             Hu[0] = Hu[3] = curvature;
             Hu[1] = Hu[2] = 0;
@@ -822,12 +812,6 @@ void sem_contact_begin_world_step(sem_contact *c)
     c->stats.min_gap = INFINITY;
 }
 
-static int find_root(int *parent, int i)
-{
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-}
-
 sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n, double h, int *island,
                                sem_error *err)
 {
@@ -871,14 +855,9 @@ sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n
             const double *a = box + 6 * (size_t)i, *b = box + 6 * (size_t)j;
             int overlap = 1;
             for (int k = 0; k < 3; ++k) overlap &= a[k] <= b[3 + k] && b[k] <= a[3 + k];
-            if (!overlap) continue;
-            int ri = find_root(island, i), rj = find_root(island, j);
-            if (ri < rj)
-                island[rj] = ri;
-            else if (rj < ri)
-                island[ri] = rj;
+            if (overlap) sem_uf_unite(island, i, j);
         }
-    for (int i = 0; i < n; ++i) island[i] = find_root(island, i);
+    for (int i = 0; i < n; ++i) island[i] = sem_uf_find(island, i);
     free(box);
     c->stats.seconds += omp_get_wtime() - t0;
     return SEM_OK;

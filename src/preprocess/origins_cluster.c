@@ -38,7 +38,7 @@
 #include <string.h>
 
 #include "steps.h"
-#include "union_find.h"
+#include "util/union_find.h"
 
 /* A group whose samples' second-moment eigenvalues have a smaller/larger ratio than this is
  * flat (its thinnest extent is under ~10 % of its largest). */

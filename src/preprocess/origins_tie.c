@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "steps.h"
-#include "union_find.h"
+#include "util/union_find.h"
 
 /* A boundary sample couples two origins when both carry at least this weight there. */
 #define TIE_WEIGHT 0.05

@@ -64,7 +64,7 @@
  * - Orientation votes stop as soon as the votes not cast yet cannot change the sign.
  */
 #include "raycast.h"
-#include "union_find.h"
+#include "util/union_find.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
