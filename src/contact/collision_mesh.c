@@ -181,6 +181,50 @@ done:
     return st;
 }
 
+/* x = J q for every point */
+static void update_positions(sem_collision_mesh *m, const double *q)
+{
+    for (int p = 0; p < m->n_points; ++p) {
+        double x[3] = {0, 0, 0};
+        for (int e = m->row_start[p]; e < m->row_start[p + 1]; ++e) {
+            const double *qc = q + 3 * (size_t)m->row_ctrl[e];
+            for (int k = 0; k < 3; ++k) x[k] += m->row_w[e] * qc[k];
+        }
+        memcpy(m->x + 3 * (size_t)p, x, sizeof x);
+    }
+}
+
+/* Face normals at the current x, and each corner's angle x its face normal summed at its
+ * welded point (the angle-weighted pseudonormal) */
+static void update_normals(sem_collision_mesh *m)
+{
+    memset(m->pseudo_normal, 0, 3 * (size_t)m->n_points * sizeof(double));
+    for (int t = 0; t < m->n_triangles; ++t) {
+        const int *tri = m->triangles + 3 * t;
+        const double *x[3] = {m->x + 3 * (size_t)tri[0], m->x + 3 * (size_t)tri[1], m->x + 3 * (size_t)tri[2]};
+        double e1[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
+        double e2[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+        double *n = m->face_normal + 3 * (size_t)t;
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(l > 0)) continue; /* a degenerate triangle has no direction */
+        for (int k = 0; k < 3; ++k) n[k] /= l;
+        for (int v = 0; v < 3; ++v) {
+            const double *o = x[v], *a = x[(v + 1) % 3], *b = x[(v + 2) % 3];
+            double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]}, w[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+            double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+            double angle = atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
+            double *pn = m->pseudo_normal + 3 * (size_t)m->weld[tri[v]];
+            for (int k = 0; k < 3; ++k) pn[k] += angle * n[k];
+        }
+    }
+    for (int p = 0; p < m->n_points; ++p)
+        if (m->weld[p] != p) memcpy(m->pseudo_normal + 3 * (size_t)p, m->pseudo_normal + 3 * (size_t)m->weld[p],
+                                    3 * sizeof(double));
+}
+
 void sem_collision_mesh_free(sem_collision_mesh *m)
 {
     free(m->row_start);
@@ -278,12 +322,11 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
         out->row_start[r + 1] = start + kept;
     }
     for (int t = 0; t < 3 * mesh.n_triangles; ++t) out->triangles[t] = used[mesh.triangles[t]];
-    for (int p = 0; p < out->n_points; ++p) out->weld[p] = p;
-    sem_collision_mesh_update(out, q, 0);
+    update_positions(out, q);
     if ((st = sem_collision_weld(out->x, out->n_points, WELD_TOLERANCE * out->length, out->weld, err)) != SEM_OK ||
         (st = orient_parts(out, &mesh, err)) != SEM_OK)
         goto done;
-    sem_collision_mesh_update(out, q, 0); /* normals of the turned triangles */
+    update_normals(out); /* of the turned triangles */
     for (int t = 0; t < out->n_triangles; ++t) {
         const int *tri = out->triangles + 3 * t;
         const double *a = out->x + 3 * (size_t)tri[0], *b = out->x + 3 * (size_t)tri[1], *c = out->x + 3 * (size_t)tri[2];
@@ -308,43 +351,12 @@ done:
     return st;
 }
 
-void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int refit_tree)
+void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int between)
 {
-    for (int p = 0; p < m->n_points; ++p) {
-        double x[3] = {0, 0, 0};
-        for (int e = m->row_start[p]; e < m->row_start[p + 1]; ++e) {
-            const double *qc = q + 3 * (size_t)m->row_ctrl[e];
-            for (int k = 0; k < 3; ++k) x[k] += m->row_w[e] * qc[k];
-        }
-        memcpy(m->x + 3 * (size_t)p, x, sizeof x);
-    }
-    /* face normals, and each corner's angle x normal summed at its welded point */
-    memset(m->pseudo_normal, 0, 3 * (size_t)m->n_points * sizeof(double));
-    for (int t = 0; t < m->n_triangles; ++t) {
-        const int *tri = m->triangles + 3 * t;
-        const double *x[3] = {m->x + 3 * (size_t)tri[0], m->x + 3 * (size_t)tri[1], m->x + 3 * (size_t)tri[2]};
-        double e1[3] = {x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]};
-        double e2[3] = {x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
-        double *n = m->face_normal + 3 * (size_t)t;
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(l > 0)) continue; /* a degenerate triangle has no direction */
-        for (int k = 0; k < 3; ++k) n[k] /= l;
-        for (int v = 0; v < 3; ++v) {
-            const double *o = x[v], *a = x[(v + 1) % 3], *b = x[(v + 2) % 3];
-            double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]}, w[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
-            double c[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-            double angle = atan2(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
-            double *pn = m->pseudo_normal + 3 * (size_t)m->weld[tri[v]];
-            for (int k = 0; k < 3; ++k) pn[k] += angle * n[k];
-        }
-    }
-    for (int p = 0; p < m->n_points; ++p)
-        if (m->weld[p] != p) memcpy(m->pseudo_normal + 3 * (size_t)p, m->pseudo_normal + 3 * (size_t)m->weld[p],
-                                    3 * sizeof(double));
-    if (refit_tree) sem_bvh_refit(&m->bvh, m->x, m->triangles);
+    update_positions(m, q);
+    if (!between) return;
+    update_normals(m);
+    sem_bvh_refit(&m->bvh, m->x, m->triangles);
 }
 
 void sem_collision_mesh_outward(const sem_collision_mesh *m, int t, int feature, int index, double out[3])

@@ -44,8 +44,10 @@ typedef struct sem_collision_mesh {
 sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_collision_mesh *out,
                                     sem_error *err);
 void sem_collision_mesh_free(sem_collision_mesh *m);
-/* x = J q for every point, face and vertex normals, and (refit_tree) the tree's boxes. */
-void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int refit_tree);
+/* x = J q for every point; with between (contact between objects, the only user of the
+ * normals and of this mesh's tree) also the face and vertex normals and the tree's boxes.
+ * The mesh as built has normals at the rest shape. */
+void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int between);
 /* The outward direction at the closest feature of triangle t (narrow_phase.h: feature,
  * index): its normal, the sum of the normals on either side of an edge, or the vertex's
  * pseudonormal. */
