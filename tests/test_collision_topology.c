@@ -51,13 +51,7 @@ static void reverse_u(sem_surface *s)
 }
 
 static unsigned long long rng = 88172645463325252ULL;
-static double uniform(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
-}
+static double uniform(void) { return test_uniform(&rng); }
 
 /* Signed distance of p to the mesh, as contact_world.c measures it. */
 static double signed_distance(const sem_collision_mesh *m, const double p[3])

@@ -12,13 +12,10 @@ static const sem_material_type all_types[SEM_MATERIAL_TYPE_COUNT] = {
     SEM_MATERIAL_STVK, SEM_MATERIAL_LINEAR};
 
 /* deterministic uniform numbers in [-1, 1] (xorshift64) */
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static unsigned long long rng_state = 0x9E3779B97F4A7C15ull;
 static double urand(void)
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) / (double)(1ull << 53) * 2.0 - 1.0;
+    return test_uniform(&rng_state) * 2.0 - 1.0;
 }
 
 static sem_material make_material(sem_material_type type)

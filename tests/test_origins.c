@@ -146,13 +146,7 @@ static void test_hand_case(void)
 
 /* xorshift: reproducible random numbers */
 static unsigned long long rng_state = 88172645463325252ull;
-static double rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) / 9007199254740992.0;
-}
+static double rnd(void) { return test_uniform(&rng_state); }
 
 /* Random W over 40 parts; 5 parts never appear, 3 appear only alone. Checks: one origin
  * per part, every origin used, isolated parts alone, and each origin's parts all lie in

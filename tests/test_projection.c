@@ -18,10 +18,7 @@
 static unsigned long long rng_state = 88172645463325252ULL;
 static double uniform(void) /* [-1, 1] */
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return 2.0 * (double)(rng_state >> 11) / 9007199254740992.0 - 1.0;
+    return 2.0 * test_uniform(&rng_state) - 1.0;
 }
 
 static double now(void)

@@ -98,3 +98,11 @@ char *test_slurp(const char *path, size_t *size)
     if (size) *size = got;
     return b;
 }
+
+double test_uniform(unsigned long long *state)
+{
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    return (double)(*state >> 11) / 9007199254740992.0;
+}

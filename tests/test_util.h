@@ -44,6 +44,9 @@ extern int test_checks;
  * TEST_SKIPPED when a shared model was missing (CTest shows the test as skipped), else 0. */
 #define TEST_SKIPPED 77
 int test_finish(const char *name);
+/* xorshift64: reproducible uniform numbers in [0, 1) from *state (non-zero), the same
+ * sequence on every machine */
+double test_uniform(unsigned long long *state);
 /* Path of a shared model (../shared/models/..., or $SEM_SHARED_MODELS/...), or NULL when it
  * is absent; a NULL answer marks the test as skipped (test_finish). */
 const char *test_shared_model(const char *relative);
