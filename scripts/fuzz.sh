@@ -7,6 +7,9 @@
 #                                            after the other, then the soak test (hours)
 #   --timeout S                              a unit slower than S seconds fails (default 10; on
 #                                            a loaded machine at nice 19, 30: docs/reliability.md)
+#   --jobs N                                 N fuzzing processes on one corpus (libFuzzer's fork
+#                                            mode; --runs counts all of them; a crash, timeout or
+#                                            out-of-memory still stops the run)
 #
 # Harnesses: iges, obj, scene, cache (fuzz/fuzz_NAME.c). Seeds: fuzz/corpus/NAME plus, when
 # present, the shared models of the right kind (SEM_SHARED_MODELS, default ../shared/models)
@@ -22,6 +25,7 @@ runs=0
 soak=0
 max_len=65536
 timeout=10
+jobs=1
 names=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -29,8 +33,9 @@ while [ $# -gt 0 ]; do
     --runs) runs="$2"; shift 2 ;;
     --max-len) max_len="$2"; shift 2 ;;
     --timeout) timeout="$2"; shift 2 ;;
+    --jobs) jobs="$2"; shift 2 ;;
     --soak) soak=1; shift ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     iges|obj|scene|cache) names+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -64,6 +69,7 @@ for n in "${names[@]}"; do
   fi
   limit=(-max_total_time="$seconds")
   [ "$runs" != 0 ] && limit=(-runs="$runs")
+  [ "$jobs" -gt 1 ] && limit+=(-fork="$jobs" -ignore_crashes=0 -ignore_timeouts=0 -ignore_ooms=0)
   log="$build/logs/$n.log"
   echo "fuzz: $n: ${limit[*]}, corpus $corpus" >&2
   set +e
@@ -74,7 +80,7 @@ for n in "${names[@]}"; do
       >"$log" 2>&1
   rc=$?
   set -e
-  grep -E '^#[0-9]+ +DONE|stat::number_of_executed_units|stat::peak_rss_mb' "$log" >&2 || true
+  grep -E '^#[0-9]+ +DONE|stat::number_of_executed_units|stat::peak_rss_mb|fuzzed for' "$log" >&2 || true
   if [ $rc -ne 0 ]; then
     echo "fuzz: $n FAILED (exit $rc); input saved in $crashes/, log in $log:" >&2
     grep -E 'ERROR|SUMMARY|fuzz:' "$log" | head -5 >&2 || true
