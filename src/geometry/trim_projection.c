@@ -37,6 +37,7 @@ typedef struct point {
     double t;
     double uv[2];
     double x[3]; /* S(uv) */
+    double d;    /* distance of the curve point from x */
 } point;
 
 typedef struct chain {
@@ -145,12 +146,19 @@ static int push(chain *ch, const point *p)
     return 1;
 }
 
-static void project(context *c, const sem_curve *cv, double t, const double *guess, point *out)
+/* The curve point at t onto the surface, starting from guess. A guess is taken without trying
+ * the sampler's starts when it ends no farther from the surface than `near` (the distance of
+ * the curve's neighbouring points; 0 for a first point) plus a tenth of the tolerance: the
+ * distance varies continuously along the curve, so such a guess follows the same nearest sheet
+ * (on a curve that lies on its surface, near is 0 and this is the plain test). */
+static void project(context *c, const sem_curve *cv, double t, const double *guess, double near,
+                    point *out)
 {
     double X[3];
     sem_curve_eval(cv, t, X, NULL);
     out->t = t;
-    double d = sem_surface_closest_point(c->sampler, X, guess, 0.1 * c->tol, out->uv);
+    double d = sem_surface_closest_point(c->sampler, X, guess, near + 0.1 * c->tol, out->uv);
+    out->d = d;
     if (d > c->worst) c->worst = d;
     sem_surface_eval(c->s, out->uv[0], out->uv[1], out->x, NULL, NULL, NULL);
 }
@@ -162,7 +170,7 @@ static int refine(context *c, const sem_curve *cv, const point *a, const point *
     if (depth < MAX_DEPTH && ch->n < MAX_POINTS) {
         point m;
         double mid_uv[2] = {0.5 * (a->uv[0] + b->uv[0]), 0.5 * (a->uv[1] + b->uv[1])};
-        project(c, cv, 0.5 * (a->t + b->t), mid_uv, &m);
+        project(c, cv, 0.5 * (a->t + b->t), mid_uv, a->d > b->d ? a->d : b->d, &m);
         double chord[3];
         sem_surface_eval(c->s, mid_uv[0], mid_uv[1], chord, NULL, NULL, NULL);
         if (dist3(chord, m.x) > c->tol) {
@@ -193,7 +201,7 @@ static int project_curve(context *c, const sem_curve *cv, int reverse, const dou
         double t = span >= nb - 1 ? breaks[nb - 1]
                                   : breaks[span] + (breaks[span + 1] - breaks[span]) * r / per;
         point p;
-        project(c, cv, t, k == 0 ? guess : prev.uv, &p);
+        project(c, cv, t, k == 0 ? guess : prev.uv, k == 0 ? 0.0 : prev.d, &p);
         if (k == 0) {
             if (!push(ch, &p)) return 0;
         } else if (!refine(c, cv, &prev, &p, 0, ch)) {

@@ -366,7 +366,7 @@ def circle3(f):
     return nurbs_curve(2, CIRCLE_KNOTS, [f(x, y) for x, y in CIRCLE_XY], CIRCLE_W)
 
 
-def file_model_space():
+def file_model_space(name="iges_model_space.igs", off=0.0):
     """Trims given in model space only (no parameter-space curves anywhere), with closed
     forms for the trimmed areas:
     part 0: 143 on the plane patch [0,2]x[0,1] (z = 0); outer 141 TYPE 0 = the patch's own
@@ -377,7 +377,11 @@ def file_model_space():
             the seam edge down: area 2 pi (the mean height is 1)
     part 2: 510 on the unit sphere (u longitude with a seam, v latitude with poles): the cap
             above z = 1/2; loop = the latitude circle, the seam meridian up to the pole and
-            down again: area 2 pi h = pi"""
+            down again: area 2 pi h = pi
+    off > 0: every trim curve lies off its surface by off (the plate's lifted, the others'
+    moved out radially), as a CAD file's edges lie within its tolerance: the projected loops
+    and the areas are the same"""
+    k = 1.0 + off
     sub = "00010000"
     E = []
 
@@ -388,13 +392,13 @@ def file_model_space():
     # part 0
     t143 = add(None)
     plane = add(Ent(128, patch(0, 0, 0, 2, 1), status=sub))
-    corners = [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)]
+    corners = [(0, 0, off), (2, 0, off), (2, 1, off), (0, 1, off)]
     border = [add(Ent(110, line(corners[k], corners[(k + 1) % 4]), status=sub)) for k in range(4)]
     outer = ["0", "0", de(plane), "4"]
     for b in border:
         outer += [de(b), "1", "0"]
     o141 = add(Ent(141, outer, status=sub))
-    circle = add(Ent(100, ["0.0", "1.0", "0.5", "1.3", "0.5", "1.3", "0.5"], status=sub))
+    circle = add(Ent(100, [r(off), "1.0", "0.5", "1.3", "0.5", "1.3", "0.5"], status=sub))
     h141 = add(Ent(141, ["0", "0", de(plane), "1", de(circle), "1", "0"], status=sub))
     E[t143] = Ent(143, ["0", de(plane), "2", de(o141), de(h141)])
 
@@ -416,12 +420,14 @@ def file_model_space():
     c30, s30 = math.sqrt(3) / 2, 0.5
     verts = [(1, 0, 0), (1, 0, 1.5), (c30, 0, s30), (0, 0, 1)]
     vl = add(Ent(502, ["4"] + [r(x) for p in verts for x in p], form=1, status=sub))
-    bottom = add(Ent(126, circle3(lambda x, y: (x, y, 0)), status=sub))
-    seam = add(Ent(110, line((1, 0, 0), (1, 0, 1.5)), status=sub))
-    ellipse = add(Ent(126, circle3(lambda x, y: (x, y, 1 + 0.5 * x)), status=sub))
-    latitude = add(Ent(126, circle3(lambda x, y: (c30 * x, c30 * y, s30)), status=sub))
+    bottom = add(Ent(126, circle3(lambda x, y: (k * x, k * y, 0)), status=sub))
+    seam = add(Ent(110, line((k, 0, 0), (k, 0, 1.5)), status=sub))
+    ellipse = add(Ent(126, circle3(lambda x, y: (k * x, k * y, 1 + 0.5 * x)), status=sub))
+    latitude = add(Ent(126, circle3(lambda x, y: (k * c30 * x, k * c30 * y, k * s30)),
+                       status=sub))
     meridian = add(Ent(126, nurbs_curve(2, [0, 0, 0, 1, 1, 1],
-                                        [(c30, 0, s30), (0.5 / c30, 0, 1), (0, 0, 1)],
+                                        [(k * c30, 0, k * s30), (k * 0.5 / c30, 0, k),
+                                         (0, 0, k)],
                                         [1, c30, 1]), status=sub))
     edges = [(bottom, 1, 1), (seam, 1, 2), (ellipse, 2, 2), (latitude, 3, 3), (meridian, 3, 4)]
     ep = [str(len(edges))]
@@ -441,7 +447,9 @@ def file_model_space():
     E[i514] = Ent(514, ["2", de(f_cyl), "1", de(f_sph), "1"], form=1, status=sub)
     E[f_cyl] = Ent(510, [de(cyl), "1", "1", de(l_cyl)], form=1, status=sub)
     E[f_sph] = Ent(510, [de(sph), "1", "1", de(l_sph)], form=1, status=sub)
-    save("iges_model_space.igs", build(E))
+    save(name, build(E))
+    if off:
+        return
     # the same plate with its hole's circle 0.5 above the plane: it cannot be projected;
     # the reader warns and leaves that loop out
     E = E[:h141 + 1]
@@ -591,5 +599,6 @@ if __name__ == "__main__":
     file_cad_trimmed()
     file_bptr0()
     file_model_space()
+    file_model_space("iges_model_space_near.igs", 1e-4)
     file_analytic()
     errors()
