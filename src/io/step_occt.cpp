@@ -358,10 +358,11 @@ std::vector<Handle(Geom2d_BSplineCurve)> wire_curves(const TopoDS_Wire &wire, co
     for (BRepTools_WireExplorer wex(wire, face); wex.More(); wex.Next()) edges.push_back(wex.Current());
     for (TopoDS_Iterator it(wire); it.More(); it.Next())
         if (it.Value().ShapeType() == TopAbs_EDGE) stored.push_back(TopoDS::Edge(it.Value()));
-    /* The explorer follows the wire's vertices and stops where it cannot choose: at the apex
-     * of a converted cone, where a side edge, the collapsed edge and the other side meet within
-     * 1e-8 of each other, it gave 2 of 4 edges and the loop did not close (NIST CTC-01, face
-     * 57). Then the wire's edges are taken as stored and chained by their (u,v) ends. */
+    /* The explorer follows the wire's vertices and stops where it cannot choose: at a
+     * collapsed edge of a converted face (a cone's apex, a sphere's pole), where a side edge,
+     * the collapsed edge and the other side meet within 1e-8 of each other, it gave 2 of 4
+     * edges and the loop did not close (NIST CTC-01 face 57, CTC-02 face 52). Then the wire's
+     * edges are taken as stored and chained by their (u,v) ends. */
     bool chain = edges.size() < stored.size();
     if (chain) edges = stored;
     for (const TopoDS_Edge &e : edges) {
