@@ -41,6 +41,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ ${#names[@]} -gt 0 ] || names=(iges obj scene cache)
+for value in "--time $seconds" "--runs $runs" "--max-len $max_len" "--timeout $timeout" "--jobs $jobs"; do
+  [[ "${value#* }" =~ ^[0-9]+$ ]] || { echo "fuzz.sh: ${value% *} needs a whole number, not '${value#* }'" >&2; exit 2; }
+done
 
 build="${SEM_FUZZ_BUILD:-build-fuzz}"
 bash scripts/setup.sh --fuzz
