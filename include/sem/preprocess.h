@@ -38,6 +38,25 @@ typedef enum sem_origin_rule {
                                 merged (src/preprocess/origins.c, origins_merge.c) */
 } sem_origin_rule;
 
+/* Which parts share a polynomial (Sec. 6, Eq. 7). The paper fits one polynomial per part (its
+ * translation shared by the parts of an origin). A model of many small faces (a machined part
+ * read from STEP: hundreds of faces of 6 to 20 control points) then has as many coefficients
+ * as control points, which no solver handles at scale: neither the structured solver (its dense
+ * Schur complement is as large as the coefficient space) nor the q-space solvers (the matrix
+ * over control points is nearly full). Fitting one polynomial per origin (over the samples of
+ * all its parts, order by order as Eq. 7) makes the coefficient space origins x m: every part
+ * of an origin moves with its origin's polynomial, so the model is coarser (stiffer) than the
+ * paper's; docs/preprocessing.md "Shared fits" measures by how much. */
+typedef enum sem_fit_rule {
+    SEM_FIT_AUTO = 0,    /* default: per part, unless neither solver takes the per-part model:
+                            the structured solver needs n_ctrl >= 2 n_parts m and
+                            3 n_parts m <= SEM_MAX_STRUCTURED_COEFFICIENTS, and the q-space
+                            solvers are kept to 3 n_ctrl <= SEM_MAX_PER_PART_Q_SPACE_DOFS;
+                            otherwise per origin (sem_preprocess_shared_fit) */
+    SEM_FIT_PARTS = 1,   /* always per part (the paper) */
+    SEM_FIT_ORIGINS = 2  /* always per origin */
+} sem_fit_rule;
+
 typedef struct sem_preprocess_options {
     int order;               /* 1 (linear) or 2 (quadratic, default) */
     /* Volume quadrature (Sec. 6.3). Default: a ray grid laid in the object's own frame (the
@@ -56,6 +75,7 @@ typedef struct sem_preprocess_options {
                                 the median part size (its samples' bbox diagonal) */
     double weight_threshold; /* weights below are dropped; default 1e-4 */
     int origin_rule;         /* sem_origin_rule; default SEM_ORIGINS_COUPLED */
+    int fit_rule;            /* sem_fit_rule; default SEM_FIT_AUTO */
     double gamma;            /* error-energy stiffness; <= 0: default kappa E / L */
     double youngs_modulus;   /* for the default gamma; default 1e6 */
     int tessellation;        /* triangle grid cells per knot span per direction; default 16 */
@@ -125,6 +145,8 @@ typedef struct sem_discretization {
     int *part_covered;     /* per part: 1 when no quadrature point lay in its solid (too small
                               or thin for the quadrature): it has no volume of its own and is
                               blended into the points nearest it (weights_cover.c) */
+    int shared_fit;        /* 1: every part of an origin has its origin's polynomial (rows of
+                              Pi equal within an origin; sem_fit_rule), 0: one per part */
 
     /* projection (Eq. 7): n_parts * n_basis rows x n_ctrl */
     sem_csr Pi;
@@ -161,6 +183,9 @@ sem_status sem_discretization_load_buffer(const char *name, const void *data, si
                                           sem_discretization **out, sem_error *err);
 /* Whether options form the q-space operators for this model (resolves -1). */
 int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o);
+/* Whether the parts of an origin share one polynomial for this model (resolves
+ * SEM_FIT_AUTO; sem_fit_rule). */
+int sem_preprocess_shared_fit(const sem_model *model, const sem_preprocess_options *o);
 /* Hash of a model's geometry (degrees, knots, weights, control points, trims) and options. */
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o);
 

@@ -80,8 +80,11 @@ sem_world_def sem_default_world_def(void);
 /* 1 when a world with these settings solves an object of n_ctrl control points, n_parts
  * parts and n_basis polynomial terms (4 or 10) with the structured solver (the rule of
  * SEM_SOLVER_AUTO); its discretization then needs no q-space operators
- * (sem_preprocess_options.q_space_operators), which the other solvers do. */
-int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis);
+ * (sem_preprocess_options.q_space_operators), which the other solvers do. shared_fit: the
+ * parts of an origin share one polynomial (sem_preprocess_shared_fit): made for the structured
+ * solver, which AUTO then always picks (unless objects are solved together). */
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis,
+                             int shared_fit);
 
 typedef enum sem_prescribe_type {
     SEM_PRESCRIBE_NONE,

@@ -176,7 +176,8 @@ class sem_preprocess_options(Structure):
     _c_header_ = "preprocess.h"
     _fields_ = [("order", c_int), ("spacing", c_double), ("rays", c_int * 2), ("ray_axis", c_int),
                 ("points_per_interval", c_int), ("alpha", c_double), ("sparsity", c_double),
-                ("weight_threshold", c_double), ("origin_rule", c_int), ("gamma", c_double),
+                ("weight_threshold", c_double), ("origin_rule", c_int), ("fit_rule", c_int),
+                ("gamma", c_double),
                 ("youngs_modulus", c_double), ("tessellation", c_int), ("threads", c_int),
                 ("q_space_operators", c_int)]
 
@@ -209,6 +210,7 @@ class sem_discretization(Structure):
                 ("alpha", c_double), ("W", sem_csr), ("W_samples", sem_csr),
                 ("n_origins", c_int), ("origin_X", POINTER(c_double)),
                 ("part_origin", POINTER(c_int)), ("part_covered", POINTER(c_int)),
+                ("shared_fit", c_int),
                 ("Pi", sem_csr),
                 ("Gamma", sem_csr), ("Grad", sem_csr), ("Gamma_samples", sem_csr),
                 ("M", sem_csr), ("M_eps", sem_csr), ("gamma", c_double),

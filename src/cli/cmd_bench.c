@@ -63,7 +63,8 @@ static sem_status run_row(const sem_table1_row *r, const char *path, int steps, 
     wd.solver = solver;
     /* the q-space operators only for the solvers that use them */
     po.q_space_operators =
-        !sem_world_def_structured(&wd, sem_model_control_points(m), m->n_parts, po.order == 1 ? 4 : 10);
+        !sem_world_def_structured(&wd, sem_model_control_points(m), m->n_parts, po.order == 1 ? 4 : 10,
+                                  sem_preprocess_shared_fit(m, &po));
     sem_discretization *d = NULL;
     sem_world *w = NULL;
     for (int k = 0; k < repeat; ++k) {

@@ -40,6 +40,7 @@ static cJSON *to_json(const sem_discretization *d, double total_s)
     cJSON_AddNumberToObject(j, "quadrature_points", d->n_quad);
     cJSON_AddNumberToObject(j, "volume", d->volume);
     cJSON_AddNumberToObject(j, "origins", d->n_origins);
+    cJSON_AddStringToObject(j, "fits", d->shared_fit ? "origins" : "parts");
     cJSON_AddNumberToObject(j, "alpha", d->alpha);
     cJSON_AddNumberToObject(j, "weight_nonzero_fraction", d->weight_nonzero_fraction);
     cJSON_AddNumberToObject(j, "pi_nonzeros", (double)sem_csr_nnz(&d->Pi));
@@ -113,6 +114,7 @@ static void print_human(const char *path, const sem_discretization *d, double to
     printf("  alpha                 %.6g\n", d->alpha);
     printf("  weight non-zeros      %.2f%%\n", 100.0 * d->weight_nonzero_fraction);
     printf("  deformation origins   %d\n", d->n_origins);
+    printf("  polynomials           %s\n", d->shared_fit ? "one per origin (shared fits)" : "one per part");
     printf("  Pi non-zeros          %zu\n", sem_csr_nnz(&d->Pi));
     printf("  stiffness Nnz%%        %.2f%%\n", d->stiffness_nnz_percent);
     printf("  gamma                 %.6g (L = %.6g)\n", d->gamma, d->length_scale);
@@ -145,6 +147,13 @@ int cmd_preprocess(int argc, char **argv)
             if (strcmp(v, "coupled") == 0) o.origin_rule = SEM_ORIGINS_COUPLED;
             else if (strcmp(v, "paper") == 0) o.origin_rule = SEM_ORIGINS_PAPER;
             else rc = cli_fail("--origins must be coupled or paper (got '%s')", v);
+        } else if (strcmp(a, "--fit") == 0) {
+            if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
+            const char *v = argv[++i];
+            if (strcmp(v, "auto") == 0) o.fit_rule = SEM_FIT_AUTO;
+            else if (strcmp(v, "parts") == 0) o.fit_rule = SEM_FIT_PARTS;
+            else if (strcmp(v, "origins") == 0) o.fit_rule = SEM_FIT_ORIGINS;
+            else rc = cli_fail("--fit must be auto, parts or origins (got '%s')", v);
         } else if (strcmp(a, "--blend") == 0) {
             if ((rc = cli_need_values(CMD, argc, argv, i, 1)) != CLI_OK) break;
             rc = cli_parse_double(CMD, a, argv[++i], &blend);

@@ -138,8 +138,8 @@ void sem_structured_solver_destroy(sem_structured_solver *s)
     free(s);
 }
 
-/* The distinct rows of P: a part's translation row equal (bit for bit) to an earlier part's
- * of the same group is that row. */
+/* The distinct rows of P: a part's row equal (bit for bit) to the same row of an earlier part
+ * of the same group is that row (the translation row always; every row with shared fits). */
 static sem_status reduce_rows(sem_structured_solver *s, sem_error *err)
 {
     const sem_object *o = s->o;
@@ -152,14 +152,14 @@ static sem_status reduce_rows(sem_structured_solver *s, sem_error *err)
     for (int i = 0; i < o->n_parts; ++i)
         for (int k = 0; k < m; ++k) {
             int row = i * m + k, same = -1;
-            if (k == 0)
+            if (k == 0 || o->d->shared_fit)
                 for (int j = 0; j < i && same < 0; ++j) {
                     if (o->d->part_origin[j] != o->d->part_origin[i]) continue;
-                    int a = ops->p_start[row], b = ops->p_start[j * m];
+                    int a = ops->p_start[row], b = ops->p_start[j * m + k];
                     size_t len = (size_t)(ops->p_start[row + 1] - a);
-                    if (len == (size_t)(ops->p_start[j * m + 1] - b) &&
+                    if (len == (size_t)(ops->p_start[j * m + k + 1] - b) &&
                         memcmp(ops->p_val + a, ops->p_val + b, len * sizeof(double)) == 0)
-                        same = s->red[j * m];
+                        same = s->red[j * m + k];
                 }
             if (same >= 0) {
                 s->red[row] = same;

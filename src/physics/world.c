@@ -168,13 +168,13 @@ static const sem_material *material_of_part(const sem_object *o, const sem_objec
     return &o->def.material;
 }
 
-int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis)
+int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_parts, int n_basis,
+                             int shared_fit)
 {
     size_t r0 = (size_t)n_parts * (size_t)n_basis;
     return def->solver == SEM_SOLVER_STRUCTURED ||
            (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && !def->advanced.q_space_solvers &&
-            n_ctrl >= 2 * r0 &&
-            3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS);
+            (shared_fit || (n_ctrl >= 2 * r0 && 3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS)));
 }
 
 int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err)
@@ -271,7 +271,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
      * SEM_SOLVER_AUTO: when the coefficient space (n_parts m per coordinate) is at most half
      * the control points, where its factorization is far cheaper than the q-space one (the
      * objects of one system must agree, so solving together keeps the q-space solvers) */
-    o->structured = sem_world_def_structured(&w->def, (size_t)o->n_ctrl, o->n_parts, o->m);
+    o->structured = sem_world_def_structured(&w->def, (size_t)o->n_ctrl, o->n_parts, o->m, d->shared_fit);
     if (!o->structured && sem_csr_nnz(&d->M) == 0 && o->n_ctrl > 0) {
         st = sem_error_set(err, SEM_ERR_INVALID,
                            "the %s solver needs the q-space operators: preprocess with "

@@ -44,7 +44,7 @@
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
 
-#define SEM_DISC_FORMAT_VERSION 5u
+#define SEM_DISC_FORMAT_VERSION 6u
 #define SEM_DISC_BYTE_ORDER 0x01020304u
 static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
 
@@ -65,6 +65,7 @@ sem_preprocess_options sem_default_preprocess_options(void)
     o.sparsity = 0.0;
     o.weight_threshold = 1e-4;
     o.origin_rule = SEM_ORIGINS_COUPLED;
+    o.fit_rule = SEM_FIT_AUTO;
     o.gamma = 0.0;    /* default kappa E / L (operators step) */
     o.youngs_modulus = 1e6;
     o.tessellation = 16;
@@ -120,6 +121,10 @@ static sem_status validate_options(const sem_preprocess_options *o, sem_error *e
     if (o->origin_rule != SEM_ORIGINS_COUPLED && o->origin_rule != SEM_ORIGINS_PAPER)
         return sem_error_set(err, SEM_ERR_INVALID, "origin rule must be 0 (coupled) or 1 (paper) (got %d)",
                              o->origin_rule);
+    if (o->fit_rule != SEM_FIT_AUTO && o->fit_rule != SEM_FIT_PARTS && o->fit_rule != SEM_FIT_ORIGINS)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "fit rule must be 0 (auto), 1 (parts) or 2 (origins) (got %d)",
+                             o->fit_rule);
     if (!isfinite(o->gamma) || o->gamma < 0)
         return sem_error_set(err, SEM_ERR_INVALID,
                              "gamma must be > 0 (or 0 for the default E / L) (got %g)", o->gamma);
@@ -191,13 +196,31 @@ static void hash_loop(fnv *f, const sem_trim_loop *l)
     for (int k = 0; k < l->n_curves && l->curves; ++k) hash_curve(f, &l->curves[k]);
 }
 
+/* Whether the structured solver takes the per-part model (the rule of SEM_SOLVER_AUTO,
+ * sem_world_def_structured). */
+static int per_part_structured(size_t n_ctrl, size_t n_parts, size_t m)
+{
+    return n_ctrl >= 2 * n_parts * m && 3 * n_parts * m <= SEM_MAX_STRUCTURED_COEFFICIENTS;
+}
+
+int sem_preprocess_shared_fit(const sem_model *model, const sem_preprocess_options *o)
+{
+    if (o->fit_rule == SEM_FIT_PARTS) return 0;
+    if (o->fit_rule == SEM_FIT_ORIGINS) return 1;
+    size_t n_ctrl = model ? sem_model_control_points(model) : 0;
+    size_t n_parts = model ? (size_t)model->n_parts : 0, m = o->order == 1 ? 4 : 10;
+    return !per_part_structured(n_ctrl, n_parts, m) && 3 * n_ctrl > SEM_MAX_PER_PART_Q_SPACE_DOFS;
+}
+
 int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options *o)
 {
     if (o->q_space_operators >= 0) return o->q_space_operators > 2 ? 2 : o->q_space_operators;
-    /* the rule of SEM_SOLVER_AUTO for a default world (sem_world_def_structured) */
+    /* the rule of SEM_SOLVER_AUTO for a default world (sem_world_def_structured): shared
+     * fits always take the structured solver */
+    if (sem_preprocess_shared_fit(model, o)) return 0;
     size_t n_ctrl = model ? sem_model_control_points(model) : 0;
     size_t n_parts = model ? (size_t)model->n_parts : 0, m = o->order == 1 ? 4 : 10;
-    return n_ctrl < 2 * n_parts * m || 3 * n_parts * m > SEM_MAX_STRUCTURED_COEFFICIENTS;
+    return !per_part_structured(n_ctrl, n_parts, m);
 }
 
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o)
@@ -242,6 +265,7 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
         fnv_doubles(&f, v, 6);
         fnv_int(&f, o->tessellation);
         fnv_int(&f, o->origin_rule);
+        fnv_int(&f, sem_preprocess_shared_fit(model, o));
         fnv_int(&f, sem_preprocess_q_space(model, o));
     }
     return (unsigned long long)f.h;
@@ -460,6 +484,7 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     d->model_hash = sem_preprocess_hash(model, &o);
     o.tessellation = fitted_tessellation(model, o.tessellation);
     o.q_space_operators = sem_preprocess_q_space(model, &o);
+    d->shared_fit = sem_preprocess_shared_fit(model, &o);
 
     double t0 = omp_get_wtime();
     st = sem_step_sample(model, d, err);
@@ -621,6 +646,7 @@ sem_status sem_discretization_save(const sem_discretization *d, const char *path
     w_doubles(&w, d->frame_lo, 3);
     w_doubles(&w, d->frame_hi, 3);
     w_f64(&w, d->quad_spacing);
+    w_i32(&w, d->shared_fit);
 
     w_ints(&w, d->part_ctrl_offset, d->part_ctrl_offset ? (size_t)d->n_parts + 1 : 0);
     w_ints(&w, d->sample_part, d->sample_part ? (size_t)d->n_samples : 0);
@@ -932,6 +958,8 @@ sem_status sem_discretization_load_buffer(const char *name, const void *bytes, s
         }
     }
     d->quad_spacing = r_f64(&r);
+    d->shared_fit = r_i32(&r);
+    if (r.st == SEM_OK && d->shared_fit != 0 && d->shared_fit != 1) r_fail(&r, "bad shared_fit");
 
     if (r.st == SEM_OK) {
         size_t P = (size_t)d->n_parts, S = (size_t)d->n_samples, Q = (size_t)d->n_quad;

@@ -44,6 +44,14 @@
  * split leaves the well-posed directions of each part untouched for general motions and
  * needs no lambda, whose choice trades bias against conditioning.
  *
+ * Shared fits (d->shared_fit, sem_fit_rule). Every part of origin j takes the group's fit:
+ * the same order-by-order least squares over the samples of all the group's parts,
+ *   c1_G = N1_G^+ R1_G,   c2_G = N2_G^+ (B2_G - M21_G c1_G),
+ * (pseudo-inverses as above: a group whose samples are flat gets 0 in its null directions).
+ * Each part computes them itself from the group's sums alone, so the rows of the parts of one
+ * origin are equal bit for bit (the structured solver merges equal rows: its coefficient space
+ * is then origins x m). The patch test holds as for parts: affine data are fitted exactly.
+ *
  * The eigenvalues come from a cyclic Jacobi sweep written here rather than LAPACK dsyev:
  * the matrices are at most 6 x 6, the sweep is accurate for small eigenvalues, and it keeps
  * OpenBLAS (pthread build) out of the OpenMP loops.
@@ -230,6 +238,7 @@ typedef struct group {
 typedef struct context {
     const sem_discretization *d;
     int order, m;
+    int shared;        /* shared fits: every part takes its group's fit */
     int *sample_start; /* n_parts + 1 */
     int *sample_index; /* samples of each part, in sample order */
     int *group_col0;   /* per part: first column of the part inside its group's columns */
@@ -378,13 +387,20 @@ static sem_status part_solve(const context *cx, int i, sem_csr *Pi, const int *g
     }
     double K_own[N2 * N2], K_group[N2 * N2];
 
-    /* linear terms: rhs_own = S1_i - m1_i t */
-    for (int e = 0; e < N1; ++e) {
-        double *r = R + (size_t)e * nc;
-        for (size_t c = 0; c < nc; ++c) r[c] = -ps->m1[e] * g->t[c];
-        for (int c = 0; c < n; ++c) r[c0 + c] += ps->S1[(size_t)e * n + c];
+    /* linear terms: rhs_own = S1_i - m1_i t (shared fits: the group's R1) */
+    if (cx->shared) {
+        memcpy(R, g->R1, N1 * nc * sizeof *R);
+    } else {
+        for (int e = 0; e < N1; ++e) {
+            double *r = R + (size_t)e * nc;
+            for (size_t c = 0; c < nc; ++c) r[c] = -ps->m1[e] * g->t[c];
+            for (int c = 0; c < n; ++c) r[c0 + c] += ps->S1[(size_t)e * n + c];
+        }
     }
-    robust_inverse(N1, ps->N1m, g->N1m, K_own, K_group);
+    /* shared fits: the group's own pseudo-inverse (a zero "group" leaves its null
+     * directions at 0) */
+    static const double zero[N2 * N2];
+    robust_inverse(N1, cx->shared ? g->N1m : ps->N1m, cx->shared ? zero : g->N1m, K_own, K_group);
     apply_pair(N1, nc, K_own, R, K_group, g->R1, C1);
 
     if (k2) {
@@ -399,12 +415,14 @@ static sem_status part_solve(const context *cx, int i, sem_csr *Pi, const int *g
                     own -= ps->M21[e * N1 + f] * C1[(size_t)f * nc + c];
                     grp -= g->M21[e * N1 + f] * C1[(size_t)f * nc + c];
                 }
-                r[c] = own;
+                r[c] = cx->shared ? grp : own;
                 rg[c] = grp;
             }
-            for (int c = 0; c < n; ++c) r[c0 + c] += ps->S2[(size_t)e * n + c];
+            if (!cx->shared)
+                for (int c = 0; c < n; ++c) r[c0 + c] += ps->S2[(size_t)e * n + c];
         }
-        robust_inverse(N2, ps->N2m, g->N2m, K_own, K_group);
+        robust_inverse(N2, cx->shared ? g->N2m : ps->N2m, cx->shared ? zero : g->N2m, K_own,
+                       K_group);
         apply_pair(N2, nc, K_own, R, K_group, RG, C2);
     }
 
@@ -515,6 +533,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
     cx.d = d;
     cx.order = order;
     cx.m = m;
+    cx.shared = d->shared_fit != 0;
     /* samples of each part (sampling already emits them in order) */
     sem_samples_by_part(d, &cx.sample_start, &cx.sample_index);
     cx.group_col0 = malloc((size_t)n_parts * sizeof *cx.group_col0);

@@ -303,6 +303,18 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
         else
             return fail(c, w, "must be \"coupled\" or \"paper\"");
     }
+    const cJSON *fit = cJSON_GetObjectItemCaseSensitive(s, "fit");
+    if (fit) {
+        snprintf(w, sizeof w, "%s.fit", where);
+        if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "auto"))
+            o->fit_rule = SEM_FIT_AUTO;
+        else if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "parts"))
+            o->fit_rule = SEM_FIT_PARTS;
+        else if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "origins"))
+            o->fit_rule = SEM_FIT_ORIGINS;
+        else
+            return fail(c, w, "must be \"auto\", \"parts\" or \"origins\"");
+    }
     const cJSON *spc = cJSON_GetObjectItemCaseSensitive(s, "spacing");
     if (spc && !cJSON_IsNull(spc)) {
         if ((st = get_number(c, s, "spacing", where, &o->spacing)) != SEM_OK) return st;

@@ -203,7 +203,8 @@ static sem_status prepare_object(sem_scene_world *sw, int i, const sem_scene_wor
     sem_preprocess_options popt = so->sem;
     sem_world_def wdef = scene_world_def(scene);
     popt.q_space_operators = !sem_world_def_structured(&wdef, sem_model_control_points(model),
-                                                       model->n_parts, popt.order == 1 ? 4 : 10);
+                                                       model->n_parts, popt.order == 1 ? 4 : 10,
+                                                       sem_preprocess_shared_fit(model, &popt));
     st = preprocess_cached(model, &popt, o, &sw->discs[i], &cached, err);
     if (st != SEM_OK) return prefix_error(err, st, name, i, ": ");
     sw->all_cached &= cached;
