@@ -388,6 +388,131 @@ static void test_matches_dense_least_squares(void)
     sem_model_destroy(m);
 }
 
+/* Shared fits (sem_fit_rule): every part of an origin takes the order-by-order fit over the
+ * samples of all its origin's parts. Checked against a dense least-squares solve over the
+ * group's samples (LAPACK), with rows equal bit for bit within an origin, and the patch test:
+ * for an affine motion every part has t = A Xbar + b, c1 = A, c2 = 0, flat faces included
+ * (each group here spans 3D and its quadratic fit is well posed: no quadratic vanishes on
+ * three faces of a box, or on three faces and a sphere). */
+static void test_shared_fits(void)
+{
+    sem_model *m = box_model();
+    sem_sphere_def sd = sem_default_sphere_def();
+    sd.center[0] = 4;
+    sem_primitive_sphere(m, &sd, NULL);
+    const int groups[7] = {0, 0, 0, 1, 1, 1, 1};
+    sem_discretization d;
+    sem_error err;
+    sem_status st = make_disc(m, groups, 2, &d, &err);
+    d.shared_fit = 1;
+    if (st == SEM_OK) st = sem_step_projection(NULL, &d, &err);
+    CHECK(st == SEM_OK, "%s", err.message);
+    if (st != SEM_OK) {
+        free_disc(&d);
+        sem_model_destroy(m);
+        return;
+    }
+    const int mb = d.n_basis;
+    /* equal rows within an origin */
+    int equal = 1;
+    for (int i = 1; i < d.n_parts; ++i) {
+        int first = 0;
+        while (d.part_origin[first] != d.part_origin[i]) ++first;
+        for (int k = 0; k < mb; ++k) {
+            int a = d.Pi.row_start[i * mb + k], b = d.Pi.row_start[first * mb + k];
+            int len = d.Pi.row_start[i * mb + k + 1] - a;
+            equal &= len == d.Pi.row_start[first * mb + k + 1] - b &&
+                     memcmp(d.Pi.val + a, d.Pi.val + b, (size_t)len * sizeof(double)) == 0 &&
+                     memcmp(d.Pi.col + a, d.Pi.col + b, (size_t)len * sizeof(int)) == 0;
+        }
+    }
+    CHECK(equal, "the parts of an origin have equal rows of Pi");
+
+    /* a general motion against the dense least squares over the group */
+    double *Q = malloc(3 * (size_t)d.n_ctrl * sizeof *Q);
+    sem_model_get_q(m, Q);
+    for (int k = 0; k < 3 * d.n_ctrl; ++k) Q[k] += 0.3 * uniform();
+    double *x = malloc(3 * (size_t)d.n_samples * sizeof *x);
+    sem_csr_multiply(&d.J_hat, Q, 3, x);
+    double max_err = 0;
+    for (int j = 0; j < d.n_origins; ++j) {
+        const double *Xbar = d.origin_X + 3 * j;
+        double t[3] = {0, 0, 0}, area = 0;
+        int n = 0;
+        for (int s = 0; s < d.n_samples; ++s)
+            if (d.part_origin[d.sample_part[s]] == j) {
+                area += d.sample_area[s];
+                n++;
+                for (int e = 0; e < 3; ++e) t[e] += d.sample_area[s] * x[3 * s + e];
+            }
+        for (int e = 0; e < 3; ++e) t[e] /= area;
+        double *P1 = malloc((size_t)n * 3 * sizeof *P1), *P2 = malloc((size_t)n * 6 * sizeof *P2);
+        double *R = malloc((size_t)n * 3 * sizeof *R), *R2 = malloc((size_t)n * 3 * sizeof *R2);
+        int row = 0;
+        for (int s = 0; s < d.n_samples; ++s) {
+            if (d.part_origin[d.sample_part[s]] != j) continue;
+            double w = sqrt(d.sample_area[s]), p[3], bb[10];
+            for (int e = 0; e < 3; ++e) p[e] = d.sample_X[3 * s + e] - Xbar[e];
+            basis(2, p, bb);
+            for (int k = 0; k < 3; ++k) P1[row * 3 + k] = w * bb[1 + k];
+            for (int k = 0; k < 6; ++k) P2[row * 6 + k] = w * bb[4 + k];
+            for (int e = 0; e < 3; ++e) R[row * 3 + e] = w * (x[3 * s + e] - t[e]);
+            row++;
+        }
+        memcpy(R2, R, (size_t)n * 3 * sizeof *R);
+        double *P1c = malloc((size_t)n * 3 * sizeof *P1c);
+        memcpy(P1c, P1, (size_t)n * 3 * sizeof *P1);
+        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 3, 3, P1c, 3, R2, 3);
+        double c1[9];
+        memcpy(c1, R2, sizeof c1);
+        for (int r = 0; r < n; ++r)
+            for (int e = 0; e < 3; ++e)
+                for (int k = 0; k < 3; ++k) R[r * 3 + e] -= P1[r * 3 + k] * c1[k * 3 + e];
+        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 6, 3, P2, 6, R, 3);
+        for (int i = 0; i < d.n_parts; ++i) {
+            if (d.part_origin[i] != j) continue;
+            double C[30], scale = 0;
+            sem_projection_coefficients(&d, i, Q, 3, C);
+            for (int k = 0; k < 30; ++k) scale = fmax(scale, fabs(C[k]));
+            for (int e = 0; e < 3; ++e) {
+                max_err = fmax(max_err, fabs(C[e] - t[e]) / scale);
+                for (int k = 0; k < 3; ++k) max_err = fmax(max_err, fabs(C[(1 + k) * 3 + e] - c1[k * 3 + e]) / scale);
+                for (int k = 0; k < 6; ++k) max_err = fmax(max_err, fabs(C[(4 + k) * 3 + e] - R[k * 3 + e]) / scale);
+            }
+        }
+        free(P1);
+        free(P2);
+        free(R);
+        free(R2);
+        free(P1c);
+    }
+    CHECK_NEAR(max_err, 0, 1e-10);
+
+    /* the patch test, every part (flat ones too) */
+    double A[3][3], b[3];
+    random_affine(A, b, 2.0);
+    double *Qa = affine_q(m, A, b);
+    double patch = 0;
+    for (int i = 0; i < d.n_parts; ++i) {
+        const double *Xbar = d.origin_X + 3 * d.part_origin[i];
+        double C[30];
+        sem_projection_coefficients(&d, i, Qa, 3, C);
+        for (int e = 0; e < 3; ++e) {
+            double t = b[e];
+            for (int k = 0; k < 3; ++k) t += A[e][k] * Xbar[k];
+            patch = fmax(patch, fabs(C[e] - t) / (fabs(t) + 1));
+            for (int k = 0; k < 3; ++k) patch = fmax(patch, fabs(C[(1 + k) * 3 + e] - A[e][k]));
+            for (int k = 4; k < mb; ++k) patch = fmax(patch, fabs(C[k * 3 + e]));
+        }
+    }
+    CHECK_NEAR(patch, 0, 1e-10);
+    free(Qa);
+    free(Q);
+    free(x);
+    free_disc(&d);
+    sem_model_destroy(m);
+}
+
 /* A tilted planar square whose origin lies in its plane: alone in its group the normal
  * direction is undetermined (finite Pi, in-plane terms exact, normal terms 0); sharing the
  * origin with a sphere centred in the same plane, the group fixes it and the fit is exact. */
@@ -669,6 +794,7 @@ int main(void)
 {
     test_box_patch();
     test_matches_dense_least_squares();
+    test_shared_fits();
     test_planar_square();
     test_part_without_samples();
     test_errors();

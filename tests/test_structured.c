@@ -106,6 +106,65 @@ static double max_diff(const double *a, const double *b, const double *ref, size
     return d;
 }
 
+/* Shared fits (sem_fit_rule): a 3-section beam (14 parts) whose origins each hold several
+ * faces, one polynomial per origin. The structured solver keeps one of the equal rows of Pi
+ * (origins x m coefficients) and must give the q-space solver's states; a free body keeps a
+ * rigid translation; and under solver auto a shared model takes the structured solver even
+ * where the per-part rule would not (9 control points per part here). */
+static void test_shared_fits(void)
+{
+    sem_error err;
+    sem_model *m = sem_model_create();
+    sem_beam_def bd = sem_default_beam_def();
+    bd.sections = 3;
+    bd.length = 1.5;
+    bd.width = 0.5;
+    bd.height = 0.5;
+    if (!m || sem_primitive_beam(m, &bd, &err) != SEM_OK) {
+        CHECK(0, "beam: %s", err.message);
+        sem_model_destroy(m);
+        return;
+    }
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.fit_rule = SEM_FIT_ORIGINS;
+    CHECK(sem_preprocess_q_space(m, &po) == 0, "shared fits: no q-space operators by default");
+    po.q_space_operators = 1;
+    sem_discretization *d = NULL;
+    if (sem_preprocess(m, &po, &d, &err) != SEM_OK) {
+        CHECK(0, "preprocess: %s", err.message);
+        sem_model_destroy(m);
+        return;
+    }
+    CHECK(d->shared_fit == 1 && d->n_origins < d->n_parts, "%d origins for %d parts", d->n_origins, d->n_parts);
+    size_t n = 3 * (size_t)d->n_ctrl;
+    double *q0 = malloc(n * sizeof(double));
+    sem_model_get_q(m, q0);
+    char na[32] = "", nb[32] = "";
+    const sem_integrator integ[2] = {SEM_LINEARLY_IMPLICIT_EULER, SEM_IMPLICIT_EULER};
+    const int steps[2] = {10, 4};
+    const double tol[2] = {1e-9, 1e-6};
+    for (int t = 0; t < 2; ++t) {
+        double *qa = run(m, d, SEM_SOLVER_SPARSE, integ[t], steps[t], 1, NULL, na);
+        double *qb = run(m, d, SEM_SOLVER_AUTO, integ[t], steps[t], 1, NULL, nb);
+        if (qa && qb) {
+            double scale = 0, diff = max_diff(qa, qb, q0, n, &scale);
+            printf("shared fits, %s vs %s, %s: displacement %.4g m, states differ by %.3g m\n", na, nb,
+                   t ? "implicit Euler" : "linearly implicit", scale, diff);
+            CHECK(scale > 1e-4, "the beam should sag (%.3g m)", scale);
+            CHECK(diff <= tol[t] * scale, "shared fits: structured and q-space states differ by %.3g of %.3g",
+                  diff, scale);
+            CHECK(!strcmp(na, "cholmod") && !strcmp(nb, "structured"), "solvers %s, %s", na, nb);
+        }
+        free(qa);
+        free(qb);
+    }
+    const double v0[3] = {0.3, -0.2, 0.1};
+    for (int t = 0; t < 2; ++t) free(run(m, d, SEM_SOLVER_STRUCTURED, integ[t], 5, 0, v0, nb));
+    free(q0);
+    sem_discretization_destroy(d);
+    sem_model_destroy(m);
+}
+
 int main(void)
 {
     sem_error err;
@@ -170,5 +229,6 @@ int main(void)
     sem_model_destroy(coarse);
     free(q0);
     sem_model_destroy(m);
+    test_shared_fits();
     return test_finish("test_structured");
 }

@@ -149,8 +149,8 @@ class Model:
     def preprocess(self, **settings):
         """SEM preprocessing (paper Sec. 5-6) with the keys of a scene's "sem" object:
         order, spacing, rays, ray_axis, points_per_interval, alpha, sparsity, gamma,
-        tessellation, weight_threshold, origins ("coupled" or "paper"), plus youngs_modulus (for
-        the default gamma) and threads."""
+        tessellation, weight_threshold, origins ("coupled" or "paper"), fit ("auto", "parts" or
+        "origins"), plus youngs_modulus (for the default gamma) and threads."""
         options = lib.sem_default_preprocess_options()
         for key, value in settings.items():
             if key == "rays":
@@ -165,13 +165,17 @@ class Model:
                 if value not in ("coupled", "paper"):
                     raise ValueError('origins: "coupled" or "paper"')
                 options.origin_rule = 0 if value == "coupled" else 1
+            elif key == "fit":
+                if value not in ("auto", "parts", "origins"):
+                    raise ValueError('fit: "auto", "parts" or "origins"')
+                options.fit_rule = {"auto": 0, "parts": 1, "origins": 2}[value]
             elif key in ("alpha", "sparsity", "gamma", "spacing") and value is None:
                 setattr(options, key, 0.0)
             elif key in _OPTION_FIELDS:
                 setattr(options, key, value)
             else:
                 raise TypeError("preprocess: unknown setting %r (allowed: %s)"
-                                % (key, ", ".join(sorted(_OPTION_FIELDS | {"rays", "ray_axis", "origins"}))))
+                                % (key, ", ".join(sorted(_OPTION_FIELDS | {"rays", "ray_axis", "origins", "fit"}))))
         err = _lib.new_error()
         out = _lib._disc_p()
         check(lib.sem_preprocess(self._p, ctypes.byref(options), ctypes.byref(out),
@@ -253,6 +257,15 @@ class Discretization:
     @property
     def gamma(self):
         return self._d.gamma
+
+    @property
+    def origins(self):
+        return self._d.n_origins
+
+    @property
+    def fits(self):
+        """"parts" (one polynomial per part, the paper) or "origins" (shared fits)."""
+        return "origins" if self._d.shared_fit else "parts"
 
     @property
     def quadrature_points(self):

@@ -75,6 +75,16 @@ def test_preprocess_box_volume_and_views():
         m.preprocess(order=3)
 
 
+def test_preprocess_fits():
+    m = sem.Model.primitive("beam", sections=3)
+    own = m.preprocess(rays=[3, 3], points_per_interval=4)
+    shared = m.preprocess(rays=[3, 3], points_per_interval=4, fit="origins")
+    assert own.fits == "parts" and shared.fits == "origins"
+    assert shared.origins == own.origins and own.origins >= 1
+    with pytest.raises(ValueError):
+        m.preprocess(fit="faces")
+
+
 @pytest.mark.skipif(not sem.has_step(), reason="libsem built without Open CASCADE")
 def test_step_roundtrip(outdir):
     m = sem.Model.primitive("cylinder", radius=0.5, height=2)

@@ -200,6 +200,9 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
         cJSON_AddNumberToObject(o, "parts", sem_scene_world_model(r->sw, i)->n_parts);
         cJSON_AddNumberToObject(o, "quadrature_points", sem_scene_world_discretization(r->sw, i)->n_quad);
         cJSON_AddStringToObject(o, "solver", sem_world_solver_name(r->world, i));
+        cJSON_AddNumberToObject(o, "origins", sem_scene_world_discretization(r->sw, i)->n_origins);
+        /* one polynomial per part (the paper) or per origin (shared fits, sem_fit_rule) */
+        cJSON_AddStringToObject(o, "fits", sem_scene_world_discretization(r->sw, i)->shared_fit ? "origins" : "parts");
         cJSON_AddNumberToObject(o, "nnz_percent", sem_world_object_nnz_percent(r->world, i));
         cJSON_AddNumberToObject(o, "spurious_modes", sem_scene_world_spurious_modes(r->sw, i));
         cJSON_AddStringToObject(o, "file_units", sem_scene_world_file_units(r->sw, i));
