@@ -185,7 +185,7 @@ static void worst_cases(void)
         {1, "iges/xform_chains.igs", NULL, "encloses no volume"},
         {0, "iges/huge_degree.igs", "SEM_MAX_MODEL_SPAN_WORK", "SEM_MAX_MODEL_SPAN_WORK"},
         {1, "iges/huge_degree_accepted.igs", NULL, "SEM_MAX_BOUNDARY_ENTRIES"},
-        {1, "iges/curved_parts.igs", NULL, "SEM_MAX_PREPROCESS_CONTROL_POINTS"},
+        {1, "iges/curved_parts.igs", NULL, "SEM_MAX_SHARED_FIT_PARTS"},
         {0, "iges/trim_huge_coordinates.igs", NULL, "encloses no volume"},
         {0, "iges/trim_many_spans.igs", "SEM_MAX_TRIM_SEGMENTS", "SEM_MAX_TRIM_SEGMENTS"},
         {0, "iges/self_reference.igs", NULL, "encloses no volume"},
@@ -196,6 +196,15 @@ static void worst_cases(void)
     };
     const char *san = getenv("SEM_SANITIZED");
     int sanitized = san && san[0] == '1';
+    {   /* the per-part fits of the same model: the q-space operators' limit */
+        char path[1024];
+        snprintf(path, sizeof path, "%s/../../fuzz/regressions/iges/curved_parts.igs", SEM_TEST_DATA);
+        const char *args[] = {"preprocess", path, "--fit", "parts", NULL};
+        run_result r;
+        run_sem(args, &r);
+        check_bounded("preprocess --fit parts iges/curved_parts.igs", &r);
+        CHECK(r.status == 1 && strstr(r.err, "SEM_MAX_PREPROCESS_CONTROL_POINTS"), "--fit parts: got:\n%s", r.err);
+    }
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         if (sanitized && cases[i].heavy) continue;
         char path[1024], what[1200];

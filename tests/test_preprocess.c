@@ -326,7 +326,7 @@ static void test_save_load(void)
     memcpy(data + 8, &version, 4);
     write_bytes(bad, data, (size_t)size);
     st = sem_discretization_load(bad, 0, &e, &err);
-    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 5"),
+    CHECK(st != SEM_OK && strstr(err.message, "written by format version 99, this sem reads 6"),
           "version message: %s", err.message);
     memcpy(data, "NOTSEM!!", 8);
     write_bytes(bad, data, (size_t)size);

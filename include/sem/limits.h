@@ -51,6 +51,10 @@
                                                   origin above this many dofs (the q-space
                                                   matrix of such models is nearly full: NIST
                                                   CTC-04, 11,439 dofs, peaks at 3.5 GB) */
+#define SEM_MAX_SHARED_FIT_PARTS 1500          /* parts of a model with shared fits (its
+                                                  origins' coefficients, about a quarter of
+                                                  the parts x 30, make the structured
+                                                  solver's dense matrix; NIST CTC-02 has 637) */
 #define SEM_MAX_BOUNDARY_ENTRIES 1e7           /* boundary samples x control points each
                                                   touches ((degree + 1)^2): J-hat's size */
 #define SEM_MAX_TRIANGLES 4e6                  /* ray-casting tessellation */

@@ -421,6 +421,11 @@ static sem_status check_sizes(const sem_model *model, const sem_preprocess_optio
                                                    "with the q-space operators takes at most %d "
                                                    "(limit SEM_MAX_PREPROCESS_CONTROL_POINTS)",
                              ctrl, SEM_MAX_PREPROCESS_CONTROL_POINTS);
+    if (sem_preprocess_shared_fit(model, o) && model->n_parts > SEM_MAX_SHARED_FIT_PARTS)
+        return sem_error_set(err, SEM_ERR_INVALID, "model has %d parts; preprocessing with shared "
+                                                   "fits takes at most %d (limit "
+                                                   "SEM_MAX_SHARED_FIT_PARTS)",
+                             model->n_parts, SEM_MAX_SHARED_FIT_PARTS);
     if (ctrl > SEM_MAX_STRUCTURED_CONTROL_POINTS)
         return sem_error_set(err, SEM_ERR_INVALID, "model has %.0f control points; preprocessing "
                                                    "takes at most %d (limit "
