@@ -97,6 +97,7 @@ static void test_errors(void)
     expect_error(BOX ", \"sem\": {\"sparsity\": 1}", "", "objects[0].sem.sparsity", "(0, 1)");
     expect_error(BOX ", \"sem\": {\"order\": 3}", "", "objects[0].sem.order", "1 or 2");
     expect_error(BOX ", \"sem\": {\"seams\": \"blended\"}", "", "objects[0].sem.seams", "\"geometric\" or \"paper\"");
+    expect_error(BOX ", \"sem\": {\"fit\": \"faces\"}", "", "objects[0].sem.fit", "\"auto\", \"parts\" or \"origins\"");
     expect_error(BOX ", \"sem\": {\"alpha\": 1, \"sparsity\": 0.5}", "", "objects[0].sem: give either", "not both");
     expect_error(BOX ", \"sem\": {\"rays\": [0, 4]}", "", "objects[0].sem.rays", NULL);
     expect_error(BOX ", \"sem\": {\"ray_axis\": \"w\"}", "", "objects[0].sem.ray_axis", NULL);
@@ -164,6 +165,7 @@ static void test_defaults_and_values(void)
               o->sem.spacing == 0 && o->sem.ray_axis == -1,
           "sem defaults");
     CHECK(o->seams == SEM_SEAMS_GEOMETRIC, "seams default");
+    CHECK(o->sem.fit_rule == SEM_FIT_AUTO, "fit default");
     CHECK(o->prescribe.type == SEM_PRESCRIBE_NONE && !o->has_pin_box && o->n_pin_parts == 0, "no pins");
     sem_scene_destroy(s);
 
@@ -172,7 +174,7 @@ static void test_defaults_and_values(void)
         " \"material\": {\"type\": \"stvk\", \"density\": 7800, \"youngs_modulus\": 2e11, \"poisson_ratio\": 0.3},"
         " \"part_materials\": {\"2\": {\"youngs_modulus\": 1e9}, \"lid\": {\"type\": \"linear\"}},"
         " \"sem\": {\"order\": 1, \"alpha\": 0.25, \"rays\": [3, 7], \"ray_axis\": \"z\", \"points_per_interval\": 9,"
-        "  \"gamma\": 5e6, \"tessellation\": 4, \"weight_threshold\": 0.01, \"seams\": \"paper\"},"
+        "  \"gamma\": 5e6, \"tessellation\": 4, \"weight_threshold\": 0.01, \"seams\": \"paper\", \"fit\": \"origins\"},"
         " \"pin\": {\"box\": [[-1, -2, -3], [1, 2, 3]], \"parts\": [4, 1], \"points\": [7]},"
         " \"prescribe\": {\"rotate\": {\"axis_point\": [1, 2, 3], \"axis\": [0, 0, 2], \"degrees_per_second\": 90,"
         "  \"duration\": 2}},"
@@ -213,6 +215,7 @@ static void test_defaults_and_values(void)
     CHECK_NEAR(o->sem.gamma, 5e6, 0);
     CHECK_NEAR(o->sem.weight_threshold, 0.01, 0);
     CHECK(o->seams == SEM_SEAMS_PAPER, "seams paper");
+    CHECK(o->sem.fit_rule == SEM_FIT_ORIGINS, "fit origins");
     CHECK_NEAR(o->sem.youngs_modulus, 2e11, 0);
     CHECK(o->has_pin_box && o->pin_box[1] == -2 && o->pin_box[5] == 3, "pin box");
     CHECK(o->n_pin_parts == 2 && o->pin_parts[0] == 4 && o->pin_parts[1] == 1, "pin parts");

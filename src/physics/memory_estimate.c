@@ -43,9 +43,9 @@
  *                   operators (the structured solver, physics/structured.h): Pi over the
  *                   control points and its reduced copy in V with G (the same size again) and
  *                   V's transpose, the sample rows (J-hat and the coefficient rows g),
- *                   dense coefficient matrices (Mz, Bb, Bz, F and the Schur complement with its
- *                   scratch: about 10 (3 n_parts m)^2 doubles; with shared fits
- *                   10 (3 n_origins m)^2 and Mz, Bb, Bz (n_parts m)^2 each), S0 and its factor (about 8
+ *                   coefficient matrices (Mz, Bb, Bz by part-pair blocks, F and the Schur
+ *                   complement with its scratch: about 10 (3 n_parts m)^2 doubles; with shared
+ *                   fits 10 (3 n_origins m)^2), S0 and its factor (about 8
  *                   entries per J-hat entry) and the chunk of F's sparse solves.
  *   base            the program itself with its libraries (OpenBLAS buffers, Embree,
  *                   CHOLMOD, OpenMP stacks): 60 MB, measured as sem run's peak on a box.
@@ -183,15 +183,13 @@ sem_status sem_world_estimate_memory(const sem_discretization *d, sem_memory_est
     if (sem_csr_nnz(&d->M) == 0 && d->n_ctrl > 0) {
         out->assembly -= 162 * n_quad * BYTES_DOUBLE;
         /* the structured solver (see the opening comment): no q-space blocks */
-        /* with shared fits the dense matrices but Mz, Bb and Bz are over the distinct rows
-         * (origins x m), those three over all of P's rows */
+        /* with shared fits the dense matrices are over the distinct rows (origins x m) */
         const double r0 = d->shared_fit ? (double)ng * m : (double)np * m;
-        const double rp = (double)np * m, j_nnz = (double)sem_csr_nnz(&d->J_hat);
+        const double j_nnz = (double)sem_csr_nnz(&d->J_hat);
         const double ws_nnz = (double)sem_csr_nnz(&d->W_samples);
         out->blocks = 0;
         out->solver = 5 * pi_dense * m * (BYTES_DOUBLE + BYTES_INT) + (j_nnz + ws_nnz * m) * (BYTES_DOUBLE + BYTES_INT) +
-                      10 * 9 * r0 * r0 * BYTES_DOUBLE + (d->shared_fit ? 3 * rp * rp * BYTES_DOUBLE : 0) +
-                      8 * j_nnz * (BYTES_DOUBLE + BYTES_INT) +
+                      10 * 9 * r0 * r0 * BYTES_DOUBLE + 8 * j_nnz * (BYTES_DOUBLE + BYTES_INT) +
                       (3 * r0 <= 2000 ? 9 * r0 * r0 * BYTES_DOUBLE : 0) + /* the rest factor */
                       2 * 128 * (double)d->n_ctrl * BYTES_DOUBLE;
     }

@@ -31,7 +31,8 @@
  * the preconditioner of conjugate gradients on the exact products (M_eps x summed sample by
  * sample as above, never in factored form): one or two iterations reach round-off.
  *
- * structured_operators.c: the object's data (sample rows, P, dense Mz, Bb, Bz) and products.
+ * structured_operators.c: the object's data (sample rows, P, Mz, Bb, Bz by part-pair blocks)
+ *                         and products.
  * structured_solver.c:    the solver of one object's free dofs.
  */
 #ifndef SEM_PHYSICS_STRUCTURED_H
@@ -51,7 +52,10 @@ typedef struct sem_structured_ops {
     double *j_val;
     int *g_start, *g_idx; /* g_s over coefficients (i m + k) */
     double *g_val;
-    /* dense r0 x r0 (row-major): Mz with density, Bb, Bz (blend, over gamma) */
+    /* Mz with density, Bb, Bz (blend, over gamma): r0 x r0, stored by part-pair blocks
+     * (m x m, row-major) for the pairs (a, b) with any non-zero entry: nb_part lists the parts
+     * b of part a, ascending, from nb_start[a]; entry e's blocks start at e m^2 */
+    int *nb_start, *nb_part;
     double *Mz, *Bb, *Bz;
 } sem_structured_ops;
 

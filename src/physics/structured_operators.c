@@ -1,7 +1,10 @@
 /*
  * structured_operators.c - an object's matrices as part-sparse terms plus products through
- * Pi (structured.h): the sample rows of the error matrix, P, dense coefficient-space Mz, Bb
- * and Bz, and the products with M, M_eps, K and K0 that never form a q-space matrix.
+ * Pi (structured.h): the sample rows of the error matrix, P, coefficient-space Mz, Bb and Bz
+ * (by part-pair blocks: a part's coefficients meet only those of the parts it shares a point or
+ * a sample with, so a dense r0 x r0 matrix would be mostly zeros; NIST CTC-02 has 637 parts:
+ * 325 MB each, scanned whole by every product), and the products with M, M_eps, K and K0 that
+ * never form a q-space matrix.
  *
  * Products are summed in a fixed order whatever the thread count: P x by rows (one part's
  * rows per task), P^T y by groups (every control point is in one group, and a group sums its
@@ -29,6 +32,8 @@ void sem_structured_free(sem_object *o)
     free(s->g_start);
     free(s->g_idx);
     free(s->g_val);
+    free(s->nb_start);
+    free(s->nb_part);
     free(s->Mz);
     free(s->Bb);
     free(s->Bz);
@@ -101,8 +106,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     s->j_val = malloc((nj + 1) * sizeof(double));
     s->g_idx = malloc((ng + 1) * sizeof(int));
     s->g_val = malloc((ng + 1) * sizeof(double));
-    s->Bb = calloc((size_t)r0 * r0 + 1, sizeof(double));
-    if (!s->j_col || !s->j_val || !s->g_idx || !s->g_val || !s->Bb) {
+    if (!s->j_col || !s->j_val || !s->g_idx || !s->g_val) {
         free(rows);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the error matrix's samples");
     }
@@ -140,29 +144,98 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
             s->g_val[s->g_start[r] + k] = b[k];
         }
     }
-    /* Bb = sum_s a_s g_s^T g_s, by rows of Bb in parallel (each row sums samples in order) */
-    for (int r = 0; r < nr; ++r)
-        for (int x = s->g_start[r]; x < s->g_start[r + 1]; ++x) {
-            double ax = s->area[r] * s->g_val[x];
-            double *row = s->Bb + (size_t)s->g_idx[x] * r0;
-            for (int y = s->g_start[r]; y < s->g_start[r + 1]; ++y) row[s->g_idx[y]] += ax * s->g_val[y];
-        }
+    (void)r0;
     return SEM_OK;
 }
 
-/* Pair blocks (n_pairs x m x m, own bases) to a dense r0 x r0 matrix. */
-static double *dense_from_pairs(const sem_object *o, const double *pairs, int r0)
+static int cmp_u64(const void *a, const void *b)
 {
-    double *D = calloc((size_t)r0 * r0 + 1, sizeof(double));
-    if (!D || !pairs) return D;
+    unsigned long long x = *(const unsigned long long *)a, y = *(const unsigned long long *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The part pairs of the block storage: the pairs of Mz and Bz (o->pair_a, pair_b) and every
+ * pair of parts that meet in a sample row (Bb). */
+static sem_status build_neighbours(const sem_object *o, sem_structured_ops *s, sem_error *err)
+{
+    int m = o->m, np = o->n_parts;
+    size_t n_keys = (size_t)o->n_pairs;
+    for (int r = 0; r < s->n_rows; ++r) {
+        size_t k = (size_t)(s->g_start[r + 1] - s->g_start[r]) / (size_t)m;
+        n_keys += k * k;
+    }
+    unsigned long long *keys = malloc((n_keys + 1) * sizeof *keys);
+    s->nb_start = calloc((size_t)np + 1, sizeof(int));
+    if (!keys || !s->nb_start) {
+        free(keys);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    size_t nk = 0;
+    for (int k = 0; k < o->n_pairs; ++k)
+        keys[nk++] = (unsigned long long)o->pair_a[k] * (unsigned)np + (unsigned)o->pair_b[k];
+    for (int r = 0; r < s->n_rows; ++r)
+        for (int x = s->g_start[r]; x < s->g_start[r + 1]; x += m)
+            for (int y = s->g_start[r]; y < s->g_start[r + 1]; y += m)
+                keys[nk++] = (unsigned long long)(s->g_idx[x] / m) * (unsigned)np + (unsigned)(s->g_idx[y] / m);
+    qsort(keys, nk, sizeof *keys, cmp_u64);
+    size_t nu = 0;
+    for (size_t k = 0; k < nk; ++k)
+        if (nu == 0 || keys[k] != keys[nu - 1]) keys[nu++] = keys[k];
+    s->nb_part = malloc((nu + 1) * sizeof(int));
+    size_t nb = nu * (size_t)m * m;
+    s->Mz = calloc(nb + 1, sizeof(double));
+    s->Bb = calloc(nb + 1, sizeof(double));
+    s->Bz = calloc(nb + 1, sizeof(double));
+    if (!s->nb_part || !s->Mz || !s->Bb || !s->Bz) {
+        free(keys);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coefficient-space matrices");
+    }
+    for (size_t k = 0; k < nu; ++k) {
+        s->nb_start[keys[k] / (unsigned)np + 1]++;
+        s->nb_part[k] = (int)(keys[k] % (unsigned)np);
+    }
+    for (int a = 0; a < np; ++a) s->nb_start[a + 1] += s->nb_start[a];
+    free(keys);
+    return SEM_OK;
+}
+
+/* The block of pair (a, b) in the block storage D (the pair is always there). */
+static double *block_of(const sem_structured_ops *s, double *D, int m, int a, int b)
+{
+    int lo = s->nb_start[a], hi = s->nb_start[a + 1] - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (s->nb_part[mid] < b) lo = mid + 1;
+        else hi = mid;
+    }
+    return D + (size_t)lo * m * m;
+}
+
+/* Mz, Bz from the pair blocks (n_pairs x m x m, own bases), Bb = sum_s a_s g_s^T g_s (samples
+ * in order: each entry sums as the dense matrix did). */
+static void fill_blocks(const sem_object *o, sem_structured_ops *s, const double *Mz_pairs,
+                        const double *Bz_pairs)
+{
     int m = o->m;
     for (int k = 0; k < o->n_pairs; ++k) {
         int a = o->pair_a[k], b = o->pair_b[k];
-        const double *blk = pairs + (size_t)k * m * m;
-        for (int x = 0; x < m; ++x)
-            for (int y = 0; y < m; ++y) D[(size_t)(a * m + x) * r0 + (size_t)(b * m + y)] += blk[x * m + y];
+        for (int t = 0; t < 2; ++t) {
+            const double *src = t ? Bz_pairs : Mz_pairs;
+            if (!src) continue;
+            double *blk = block_of(s, t ? s->Bz : s->Mz, m, a, b);
+            src += (size_t)k * m * m;
+            for (int e = 0; e < m * m; ++e) blk[e] += src[e];
+        }
     }
-    return D;
+    for (int r = 0; r < s->n_rows; ++r)
+        for (int x = s->g_start[r]; x < s->g_start[r + 1]; ++x) {
+            double ax = s->area[r] * s->g_val[x];
+            int a = s->g_idx[x] / m, xa = s->g_idx[x] % m;
+            for (int y = s->g_start[r]; y < s->g_start[r + 1]; y += m) {
+                double *blk = block_of(s, s->Bb, m, a, s->g_idx[y] / m) + (size_t)xa * m;
+                for (int yy = y; yy < y + m; ++yy) blk[s->g_idx[yy] % m] += ax * s->g_val[yy];
+            }
+        }
 }
 
 sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
@@ -175,11 +248,11 @@ sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const doub
     s->r0 = o->n_parts * o->m;
     sem_status st = build_P(o, s, err);
     if (st == SEM_OK) st = build_samples(o, s, n_ties, tie_ctrl, tie_part, tie_weight, err);
+    if (st == SEM_OK) st = build_neighbours(o, s, err);
     if (st != SEM_OK) return st;
-    s->Mz = dense_from_pairs(o, Mz_pairs, s->r0);
-    s->Bz = dense_from_pairs(o, Bz_pairs, s->r0);
+    fill_blocks(o, s, Mz_pairs, Bz_pairs);
     o->K0z = malloc(((size_t)o->n_pairs * 9 * o->ma * o->ma + 1) * sizeof(double));
-    if (!s->Mz || !s->Bz || !o->K0z)
+    if (!o->K0z)
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coefficient-space matrices");
     return SEM_OK;
 }
@@ -227,20 +300,27 @@ static void apply_Pt(const sem_object *o, const double *yz, double *y)
         }
 }
 
-/* out += c D yz for a dense r0 x r0 D (same for each coordinate). */
+/* out += c D yz for D (r0 x r0, part-pair blocks; the same for each coordinate). Columns in
+ * ascending order, zeros skipped. */
 static void dense_multiply(const sem_object *o, const double *D, double c, const double *yz, double *out)
 {
-    int r0 = o->ops->r0;
+    const sem_structured_ops *s = o->ops;
+    int r0 = s->r0, m = o->m;
 #pragma omp parallel for schedule(static) num_threads(o->nthreads)
     for (int r = 0; r < r0; ++r) {
-        const double *row = D + (size_t)r * r0;
+        int a = r / m, x = r % m;
         double a0 = 0, a1 = 0, a2 = 0;
-        for (int c2 = 0; c2 < r0; ++c2) {
-            double v = row[c2];
-            if (v == 0) continue;
-            a0 += v * yz[3 * c2 + 0];
-            a1 += v * yz[3 * c2 + 1];
-            a2 += v * yz[3 * c2 + 2];
+        for (int e = s->nb_start[a]; e < s->nb_start[a + 1]; ++e) {
+            const double *row = D + ((size_t)e * m + x) * m;
+            int c0 = s->nb_part[e] * m;
+            for (int y = 0; y < m; ++y) {
+                double v = row[y];
+                if (v == 0) continue;
+                int c2 = c0 + y;
+                a0 += v * yz[3 * c2 + 0];
+                a1 += v * yz[3 * c2 + 1];
+                a2 += v * yz[3 * c2 + 2];
+            }
         }
         out[3 * r + 0] += c * a0;
         out[3 * r + 1] += c * a1;

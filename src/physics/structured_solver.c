@@ -650,15 +650,19 @@ static void add_Z(sem_structured_solver *s, double *T, size_t ld, size_t off, do
     const sem_structured_ops *ops = o->ops;
     int r0 = s->r0, m = o->m, M3 = 3 * m;
     double c = 2.0 * s->coef[1], cM = s->coef[0] / c, cK = s->coef[2] / c, cD = s->coef[3] / c;
-    /* scalar parts (the same for each coordinate); duplicates add up, so serial */
+    /* scalar parts (the same for each coordinate; part-pair blocks, columns ascending);
+     * duplicates add up, so serial */
     for (int a = 0; a < r0; ++a) {
         size_t ia = off + 3 * (size_t)s->red[a];
-        for (int b = 0; b < r0; ++b) {
-            size_t at = (size_t)a * r0 + b;
-            double v = ops->Bb[at] + ops->Bz[at] + cM * ops->Mz[at];
-            if (v == 0) continue;
-            size_t ib = off + 3 * (size_t)s->red[b];
-            for (int d = 0; d < 3; ++d) T[(ib + d) * ld + ia + d] += sign * v;
+        int pa = a / m, x = a % m;
+        for (int e = ops->nb_start[pa]; e < ops->nb_start[pa + 1]; ++e) {
+            size_t at = ((size_t)e * m + x) * m;
+            for (int y = 0; y < m; ++y) {
+                double v = ops->Bb[at + y] + ops->Bz[at + y] + cM * ops->Mz[at + y];
+                if (v == 0) continue;
+                size_t ib = off + 3 * (size_t)s->red[ops->nb_part[e] * m + y];
+                for (int d = 0; d < 3; ++d) T[(ib + d) * ld + ia + d] += sign * v;
+            }
         }
     }
     if (cK == 0 && cD == 0) return;

@@ -255,7 +255,7 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
 {
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
-                                       "tessellation", "weight_threshold", "origins", "blend", "seams", NULL};
+                                       "tessellation", "weight_threshold", "origins", "fit", "blend", "seams", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
