@@ -4,7 +4,8 @@
  * gradients on the exact products (the design is in structured.h).
  *
  * Reduced rows. Row i m + 0 of Pi is the translation t_j of part i's origin, the same for
- * every part of the group (projection.c), so P has repeated rows. Only P's row space enters
+ * every part of the group (projection.c), so P has repeated rows; with shared fits every row of
+ * a part repeats in the other parts of its origin, and r = origins x m. Only P's row space enters
  * A, so the rows are reduced: P = E P~ with P~ the distinct rows and E the 0/1 expansion;
  * then A = c S0 + P~^T Z~ P~ - c (P~^T G~ + G~^T P~) with Z~ = E^T Z E and G~ = E^T G (the
  * duplicates' rows summed). r = rows of P~ per coordinate.
