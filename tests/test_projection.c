@@ -231,6 +231,64 @@ static patch_result patch_test(const sem_model *m, const sem_discretization *d, 
     return r;
 }
 
+/* Eq. 7 solved directly by dense least squares (LAPACK), independent of projection.c, for
+ * part i at the motion Q (x: the samples' positions, J-hat Q): t over the samples of all the
+ * parts of i's origin, then c1 and c2 order by order over the samples of part `fit` (per-part
+ * fits), or of all the origin's parts when fit < 0 (shared fits). Returns the largest
+ * difference to projection.c's coefficients of part i, relative to their largest. */
+static double dense_fit_error(const sem_discretization *d, const double *Q, const double *x, int i, int fit)
+{
+    const int j = d->part_origin[i];
+    const double *Xbar = d->origin_X + 3 * j;
+    double t[3] = {0, 0, 0}, area = 0;
+    int n = 0;
+    for (int s = 0; s < d->n_samples; ++s) {
+        if (d->part_origin[d->sample_part[s]] != j) continue;
+        area += d->sample_area[s];
+        for (int e = 0; e < 3; ++e) t[e] += d->sample_area[s] * x[3 * s + e];
+        n += fit < 0 || d->sample_part[s] == fit;
+    }
+    for (int e = 0; e < 3; ++e) t[e] /= area;
+    /* weighted rows sqrt(a) [P1 | P2 | residual] */
+    double *P1 = malloc((size_t)n * 3 * sizeof *P1), *P2 = malloc((size_t)n * 6 * sizeof *P2);
+    double *R = malloc((size_t)n * 3 * sizeof *R), *R2 = malloc((size_t)n * 3 * sizeof *R2);
+    double *P1c = malloc((size_t)n * 3 * sizeof *P1c);
+    int row = 0;
+    for (int s = 0; s < d->n_samples; ++s) {
+        if (d->part_origin[d->sample_part[s]] != j || (fit >= 0 && d->sample_part[s] != fit)) continue;
+        double w = sqrt(d->sample_area[s]), p[3], bb[10];
+        for (int e = 0; e < 3; ++e) p[e] = d->sample_X[3 * s + e] - Xbar[e];
+        basis(2, p, bb);
+        for (int k = 0; k < 3; ++k) P1[row * 3 + k] = w * bb[1 + k];
+        for (int k = 0; k < 6; ++k) P2[row * 6 + k] = w * bb[4 + k];
+        for (int e = 0; e < 3; ++e) R[row * 3 + e] = w * (x[3 * s + e] - t[e]);
+        row++;
+    }
+    memcpy(P1c, P1, (size_t)n * 3 * sizeof *P1);
+    memcpy(R2, R, (size_t)n * 3 * sizeof *R);
+    LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 3, 3, P1c, 3, R2, 3); /* c1 in R2[0..8] */
+    double c1[9];
+    memcpy(c1, R2, sizeof c1);
+    for (int r = 0; r < n; ++r)
+        for (int e = 0; e < 3; ++e)
+            for (int k = 0; k < 3; ++k) R[r * 3 + e] -= P1[r * 3 + k] * c1[k * 3 + e];
+    LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 6, 3, P2, 6, R, 3); /* c2 in R[0..17] */
+    double C[30], scale = 0, err = 0;
+    sem_projection_coefficients(d, i, Q, 3, C);
+    for (int k = 0; k < 30; ++k) scale = fmax(scale, fabs(C[k]));
+    for (int e = 0; e < 3; ++e) {
+        err = fmax(err, fabs(C[e] - t[e]) / scale);
+        for (int k = 0; k < 3; ++k) err = fmax(err, fabs(C[(1 + k) * 3 + e] - c1[k * 3 + e]) / scale);
+        for (int k = 0; k < 6; ++k) err = fmax(err, fabs(C[(4 + k) * 3 + e] - R[k * 3 + e]) / scale);
+    }
+    free(P1);
+    free(P2);
+    free(R);
+    free(R2);
+    free(P1c);
+    return err;
+}
+
 static sem_model *box_model(void)
 {
     sem_model *m = sem_model_create();
@@ -313,62 +371,7 @@ static void test_matches_dense_least_squares(void)
     double *x = malloc(3 * (size_t)d.n_samples * sizeof *x);
     sem_csr_multiply(&d.J_hat, Q, 3, x);
     double max_err = 0;
-    for (int i = 0; i < d.n_parts; ++i) {
-        int j = d.part_origin[i];
-        const double *Xbar = d.origin_X + 3 * j;
-        double t[3] = {0, 0, 0}, area = 0;
-        for (int s = 0; s < d.n_samples; ++s)
-            if (d.part_origin[d.sample_part[s]] == j) {
-                area += d.sample_area[s];
-                for (int e = 0; e < 3; ++e) t[e] += d.sample_area[s] * x[3 * s + e];
-            }
-        for (int e = 0; e < 3; ++e) t[e] /= area;
-        /* weighted rows sqrt(a) [P1 | residual] */
-        int n = 0;
-        for (int s = 0; s < d.n_samples; ++s) n += d.sample_part[s] == i;
-        double *P1 = malloc((size_t)n * 3 * sizeof *P1), *P2 = malloc((size_t)n * 6 * sizeof *P2);
-        double *R = malloc((size_t)n * 3 * sizeof *R), *R2 = malloc((size_t)n * 3 * sizeof *R2);
-        double *P1c = malloc((size_t)n * 3 * sizeof *P1c), *P2c = malloc((size_t)n * 6 * sizeof *P2c);
-        int row = 0;
-        for (int s = 0; s < d.n_samples; ++s) {
-            if (d.sample_part[s] != i) continue;
-            double w = sqrt(d.sample_area[s]), p[3], bb[10];
-            for (int e = 0; e < 3; ++e) p[e] = d.sample_X[3 * s + e] - Xbar[e];
-            basis(2, p, bb);
-            for (int k = 0; k < 3; ++k) P1[row * 3 + k] = w * bb[1 + k];
-            for (int k = 0; k < 6; ++k) P2[row * 6 + k] = w * bb[4 + k];
-            for (int e = 0; e < 3; ++e) R[row * 3 + e] = w * (x[3 * s + e] - t[e]);
-            row++;
-        }
-        memcpy(P1c, P1, (size_t)n * 3 * sizeof *P1);
-        memcpy(P2c, P2, (size_t)n * 6 * sizeof *P2);
-        memcpy(R2, R, (size_t)n * 3 * sizeof *R);
-        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 3, 3, P1c, 3, R2, 3); /* c1 in R2[0..8] */
-        double c1[9];
-        memcpy(c1, R2, sizeof c1);
-        for (int r = 0; r < n; ++r)
-            for (int e = 0; e < 3; ++e) {
-                double v = R[r * 3 + e];
-                for (int k = 0; k < 3; ++k) v -= P1[r * 3 + k] * c1[k * 3 + e];
-                R[r * 3 + e] = v;
-            }
-        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 6, 3, P2c, 6, R, 3); /* c2 in R[0..17] */
-        double C[30];
-        sem_projection_coefficients(&d, i, Q, 3, C);
-        double scale = 0;
-        for (int k = 0; k < 30; ++k) scale = fmax(scale, fabs(C[k]));
-        for (int e = 0; e < 3; ++e) {
-            max_err = fmax(max_err, fabs(C[e] - t[e]) / scale);
-            for (int k = 0; k < 3; ++k) max_err = fmax(max_err, fabs(C[(1 + k) * 3 + e] - c1[k * 3 + e]) / scale);
-            for (int k = 0; k < 6; ++k) max_err = fmax(max_err, fabs(C[(4 + k) * 3 + e] - R[k * 3 + e]) / scale);
-        }
-        free(P1);
-        free(P2);
-        free(R);
-        free(R2);
-        free(P1c);
-        free(P2c);
-    }
+    for (int i = 0; i < d.n_parts; ++i) max_err = fmax(max_err, dense_fit_error(&d, Q, x, i, i));
     CHECK_NEAR(max_err, 0, 1e-10);
 
     /* deterministic: bitwise the same Pi with 1 and 2 threads */
@@ -435,57 +438,7 @@ static void test_shared_fits(void)
     double *x = malloc(3 * (size_t)d.n_samples * sizeof *x);
     sem_csr_multiply(&d.J_hat, Q, 3, x);
     double max_err = 0;
-    for (int j = 0; j < d.n_origins; ++j) {
-        const double *Xbar = d.origin_X + 3 * j;
-        double t[3] = {0, 0, 0}, area = 0;
-        int n = 0;
-        for (int s = 0; s < d.n_samples; ++s)
-            if (d.part_origin[d.sample_part[s]] == j) {
-                area += d.sample_area[s];
-                n++;
-                for (int e = 0; e < 3; ++e) t[e] += d.sample_area[s] * x[3 * s + e];
-            }
-        for (int e = 0; e < 3; ++e) t[e] /= area;
-        double *P1 = malloc((size_t)n * 3 * sizeof *P1), *P2 = malloc((size_t)n * 6 * sizeof *P2);
-        double *R = malloc((size_t)n * 3 * sizeof *R), *R2 = malloc((size_t)n * 3 * sizeof *R2);
-        int row = 0;
-        for (int s = 0; s < d.n_samples; ++s) {
-            if (d.part_origin[d.sample_part[s]] != j) continue;
-            double w = sqrt(d.sample_area[s]), p[3], bb[10];
-            for (int e = 0; e < 3; ++e) p[e] = d.sample_X[3 * s + e] - Xbar[e];
-            basis(2, p, bb);
-            for (int k = 0; k < 3; ++k) P1[row * 3 + k] = w * bb[1 + k];
-            for (int k = 0; k < 6; ++k) P2[row * 6 + k] = w * bb[4 + k];
-            for (int e = 0; e < 3; ++e) R[row * 3 + e] = w * (x[3 * s + e] - t[e]);
-            row++;
-        }
-        memcpy(R2, R, (size_t)n * 3 * sizeof *R);
-        double *P1c = malloc((size_t)n * 3 * sizeof *P1c);
-        memcpy(P1c, P1, (size_t)n * 3 * sizeof *P1);
-        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 3, 3, P1c, 3, R2, 3);
-        double c1[9];
-        memcpy(c1, R2, sizeof c1);
-        for (int r = 0; r < n; ++r)
-            for (int e = 0; e < 3; ++e)
-                for (int k = 0; k < 3; ++k) R[r * 3 + e] -= P1[r * 3 + k] * c1[k * 3 + e];
-        LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', n, 6, 3, P2, 6, R, 3);
-        for (int i = 0; i < d.n_parts; ++i) {
-            if (d.part_origin[i] != j) continue;
-            double C[30], scale = 0;
-            sem_projection_coefficients(&d, i, Q, 3, C);
-            for (int k = 0; k < 30; ++k) scale = fmax(scale, fabs(C[k]));
-            for (int e = 0; e < 3; ++e) {
-                max_err = fmax(max_err, fabs(C[e] - t[e]) / scale);
-                for (int k = 0; k < 3; ++k) max_err = fmax(max_err, fabs(C[(1 + k) * 3 + e] - c1[k * 3 + e]) / scale);
-                for (int k = 0; k < 6; ++k) max_err = fmax(max_err, fabs(C[(4 + k) * 3 + e] - R[k * 3 + e]) / scale);
-            }
-        }
-        free(P1);
-        free(P2);
-        free(R);
-        free(R2);
-        free(P1c);
-    }
+    for (int i = 0; i < d.n_parts; ++i) max_err = fmax(max_err, dense_fit_error(&d, Q, x, i, -1));
     CHECK_NEAR(max_err, 0, 1e-10);
 
     /* the patch test, every part (flat ones too) */

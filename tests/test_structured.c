@@ -106,6 +106,37 @@ static double max_diff(const double *a, const double *b, const double *ref, size
     return d;
 }
 
+/* Pinned under gravity, linearly implicit (10 steps) and implicit Euler (4 steps): `solver`
+ * (which must be the structured one) gives CHOLMOD's states on the same discretization, to
+ * round-off and to Newton's tolerance relative to the displacement. */
+static void compare_with_q_space(const sem_model *m, const sem_discretization *d, sem_solver_choice solver,
+                                 const char *what)
+{
+    size_t n = 3 * (size_t)d->n_ctrl;
+    double *q0 = malloc(n * sizeof(double));
+    sem_model_get_q(m, q0);
+    char na[32] = "", nb[32] = "";
+    const sem_integrator integ[2] = {SEM_LINEARLY_IMPLICIT_EULER, SEM_IMPLICIT_EULER};
+    const int steps[2] = {10, 4};
+    const double tol[2] = {1e-9, 1e-6}; /* relative to the displacement: round-off; Newton's tolerance */
+    for (int t = 0; t < 2; ++t) {
+        double *qa = run(m, d, SEM_SOLVER_SPARSE, integ[t], steps[t], 1, NULL, na);
+        double *qb = run(m, d, solver, integ[t], steps[t], 1, NULL, nb);
+        if (qa && qb) {
+            double scale = 0, diff = max_diff(qa, qb, q0, n, &scale);
+            printf("%s: %s vs %s, %s: displacement %.4g m, states differ by %.3g m\n", what, na, nb,
+                   t ? "implicit Euler" : "linearly implicit", scale, diff);
+            CHECK(scale > 1e-4, "%s should sag (%.3g m)", what, scale);
+            CHECK(diff <= tol[t] * scale, "%s: structured and q-space states differ by %.3g of %.3g", what,
+                  diff, scale);
+            CHECK(!strcmp(na, "cholmod") && !strcmp(nb, "structured"), "%s: solvers %s, %s", what, na, nb);
+        }
+        free(qa);
+        free(qb);
+    }
+    free(q0);
+}
+
 /* Shared fits (sem_fit_rule): a 3-section beam (14 parts) whose origins each hold several
  * faces, one polynomial per origin. The structured solver keeps one of the equal rows of Pi
  * (origins x m coefficients) and must give the q-space solver's states; a free body keeps a
@@ -136,31 +167,11 @@ static void test_shared_fits(void)
         return;
     }
     CHECK(d->shared_fit == 1 && d->n_origins < d->n_parts, "%d origins for %d parts", d->n_origins, d->n_parts);
-    size_t n = 3 * (size_t)d->n_ctrl;
-    double *q0 = malloc(n * sizeof(double));
-    sem_model_get_q(m, q0);
-    char na[32] = "", nb[32] = "";
+    compare_with_q_space(m, d, SEM_SOLVER_AUTO, "shared fits, the beam");
+    char nb[32] = "";
     const sem_integrator integ[2] = {SEM_LINEARLY_IMPLICIT_EULER, SEM_IMPLICIT_EULER};
-    const int steps[2] = {10, 4};
-    const double tol[2] = {1e-9, 1e-6};
-    for (int t = 0; t < 2; ++t) {
-        double *qa = run(m, d, SEM_SOLVER_SPARSE, integ[t], steps[t], 1, NULL, na);
-        double *qb = run(m, d, SEM_SOLVER_AUTO, integ[t], steps[t], 1, NULL, nb);
-        if (qa && qb) {
-            double scale = 0, diff = max_diff(qa, qb, q0, n, &scale);
-            printf("shared fits, %s vs %s, %s: displacement %.4g m, states differ by %.3g m\n", na, nb,
-                   t ? "implicit Euler" : "linearly implicit", scale, diff);
-            CHECK(scale > 1e-4, "the beam should sag (%.3g m)", scale);
-            CHECK(diff <= tol[t] * scale, "shared fits: structured and q-space states differ by %.3g of %.3g",
-                  diff, scale);
-            CHECK(!strcmp(na, "cholmod") && !strcmp(nb, "structured"), "solvers %s, %s", na, nb);
-        }
-        free(qa);
-        free(qb);
-    }
     const double v0[3] = {0.3, -0.2, 0.1};
     for (int t = 0; t < 2; ++t) free(run(m, d, SEM_SOLVER_STRUCTURED, integ[t], 5, 0, v0, nb));
-    free(q0);
     sem_discretization_destroy(d);
     sem_model_destroy(m);
 }
@@ -180,27 +191,9 @@ int main(void)
         sem_model_destroy(m);
         return test_finish("test_structured");
     }
-    size_t n = 3 * (size_t)d->n_ctrl;
-    double *q0 = malloc(n * sizeof(double));
-    sem_model_get_q(m, q0);
+    compare_with_q_space(m, d, SEM_SOLVER_STRUCTURED, "the refined box");
     char na[32] = "", nb[32] = "";
     const sem_integrator integ[2] = {SEM_LINEARLY_IMPLICIT_EULER, SEM_IMPLICIT_EULER};
-    const int steps[2] = {10, 4};
-    const double tol[2] = {1e-9, 1e-6}; /* relative to the displacement: round-off; Newton's tolerance */
-    for (int t = 0; t < 2; ++t) {
-        double *qa = run(m, d, SEM_SOLVER_SPARSE, integ[t], steps[t], 1, NULL, na);
-        double *qb = run(m, d, SEM_SOLVER_STRUCTURED, integ[t], steps[t], 1, NULL, nb);
-        if (qa && qb) {
-            double scale = 0, diff = max_diff(qa, qb, q0, n, &scale);
-            printf("%s vs %s, %s: displacement %.4g m, states differ by %.3g m\n", na, nb,
-                   t ? "implicit Euler" : "linearly implicit", scale, diff);
-            CHECK(scale > 1e-4, "the box should sag (%.3g m)", scale);
-            CHECK(diff <= tol[t] * scale, "structured and q-space states differ by %.3g of %.3g", diff, scale);
-            CHECK(!strcmp(na, "cholmod") && !strcmp(nb, "structured"), "solvers %s, %s", na, nb);
-        }
-        free(qa);
-        free(qb);
-    }
     /* free flight: a rigid translation stays one */
     const double v0[3] = {0.3, -0.2, 0.1};
     for (int t = 0; t < 2; ++t) free(run(m, d, SEM_SOLVER_STRUCTURED, integ[t], 5, 0, v0, nb));
@@ -227,7 +220,6 @@ int main(void)
         }
     }
     sem_model_destroy(coarse);
-    free(q0);
     sem_model_destroy(m);
     test_shared_fits();
     return test_finish("test_structured");

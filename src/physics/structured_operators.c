@@ -79,7 +79,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     int n_err = 0;
     sem_status st = sem_error_rows(o, &rows, &n_err, err);
     if (st != SEM_OK) return st;
-    int m = o->m, ns = n_err, nr = ns + n_ties, r0 = s->r0;
+    int m = o->m, ns = n_err, nr = ns + n_ties;
     s->n_rows = nr;
     s->area = malloc(((size_t)nr + 1) * sizeof(double));
     s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
@@ -144,7 +144,6 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
             s->g_val[s->g_start[r] + k] = b[k];
         }
     }
-    (void)r0;
     return SEM_OK;
 }
 
