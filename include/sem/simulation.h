@@ -198,6 +198,40 @@ typedef struct sem_object_stats {
 /* Quantities computed from the quadrature (momenta through Gamma: x and v at each
  * quadrature point). gravity_energy = -sum rho vol g . x. */
 void sem_world_object_stats(const sem_world *world, int object, sem_object_stats *stats);
+/* Checks of an object's current state that tell when its answer cannot be trusted
+ * (src/physics/object_checks.c; docs/simulation.md, "Trust"). SEM couples its parts only
+ * softly (Eq. 16), and where that coupling is too weak the faces of a body come apart while
+ * every energy stays finite; these numbers make it visible. */
+typedef struct sem_object_checks {
+    double seam_gap;          /* largest opening of a seam, m: how much farther apart two
+                                 points of different parts are than at rest, over the points
+                                 where parts meet at rest (sem/measure.h, "Seams") */
+    double seam_gap_relative; /* seam_gap / the object's size (its surface's box diagonal) */
+    int seam_parts[2];        /* the two parts of that seam; -1 when none opened */
+    double seam_X[3];         /* where (m) */
+    int seam_pairs;           /* point pairs watched (0: no part meets another) */
+    double error_share;       /* error energy / (elastic + error energy) (Eq. 16 against
+                                 Eq. 15); 0 while both are below SEM_CHECK_ENERGY_FLOOR E V */
+    double volume_change;     /* sum_p vol_p det F_p / rest volume - 1 */
+    double min_det_f;         /* smallest det F over the quadrature points */
+    int suspect;              /* SEM_SUSPECT_* flags of the limits below that are passed */
+} sem_object_checks;
+
+/* Limits beyond which a state is suspect. Measured on the paper's scenes and the public
+ * corpus (docs/validation.md, "Seams and trust"). */
+#define SEM_SEAM_GAP_LIMIT 0.01      /* seam_gap_relative */
+#define SEM_ERROR_SHARE_LIMIT 0.5    /* error_share */
+#define SEM_VOLUME_CHANGE_LIMIT 0.05 /* |volume_change| */
+#define SEM_CHECK_ENERGY_FLOOR 1e-9  /* x E V: energies below are noise for error_share */
+#define SEM_SUSPECT_SEAM 1
+#define SEM_SUSPECT_ERROR_SHARE 2
+#define SEM_SUSPECT_VOLUME 4
+
+/* The checks of object `object` now. The first call finds the object's seams (a pass over
+ * its parts' boundaries, about the cost of a few steps); later calls cost about one
+ * evaluation of the elastic energy. */
+sem_status sem_world_object_checks(sem_world *world, int object, sem_object_checks *out, sem_error *err);
+
 /* Timing of the last step and the solver in use ("cholmod" or "dense"). */
 double sem_world_last_step_seconds(const sem_world *world);
 double sem_world_last_factor_seconds(const sem_world *world);

@@ -1,6 +1,6 @@
 /*
- * cmd_run.c - `sem run [SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--overwrite]`
- * and `sem run --resume DIR`.
+ * cmd_run.c - `sem run [SCENE] [--frames N] [--out DIR] [--json] [--no-cache] [--overwrite]
+ * [--strict]` and `sem run --resume DIR`.
  *
  * Loads a scene (or the embedded default when no SCENE is given), preprocesses every
  * object (reusing a cached discretization keyed by the model's content and the SEM
@@ -17,6 +17,12 @@
  * numbers are the bits an uninterrupted run writes (timings aside), also after kill -9.
  * If a step fails (NaN, explosion), everything written so far stays on disk, the USD and
  * summary are written with the frames done, and the exit status is 1.
+ *
+ * Trust. Every frame, each object's checks (sem_world_object_checks: seam openings, the error
+ * energy's share, the volume) go into summary.json; the first frame that passes a limit gets
+ * a one-line warning naming the object, the parts and the frame, and the run's status is
+ * "suspect" instead of "ok". With --strict that frame ends the run as a failure (exit 1,
+ * frames kept).
  *
  * A folder that holds another run's files is refused unless --overwrite is given, which
  * first removes exactly those files (frames, animation, preprocess_K.semdisc, summary,
@@ -92,6 +98,12 @@ typedef struct run_state {
     sem_run_info info;
     unsigned long long run_id;
     size_t *dofs; /* doubles in q per object */
+    /* the trust checks (sem_world_object_checks) over the frames so far: the worst of each
+     * kind, and for each limit passed the first frame and object that passed it */
+    double worst_seam, worst_share, worst_volume;
+    int suspect;                      /* SEM_SUSPECT_* flags passed so far */
+    char suspect_message[3][512];     /* per flag bit: the warning of its first frame */
+    int strict;                       /* --strict: the first suspect frame fails the run */
 } run_state;
 
 static void frame_stats(run_state *r, double t, double *x)
@@ -130,6 +142,66 @@ static void frame_stats(run_state *r, double t, double *x)
     x[STAT_MIN_GAP] = cs.min_gap;
 }
 
+/* "part 3 (Face3)" or "part 3" */
+static void part_label(const sem_model *m, int part, char *out, size_t size)
+{
+    if (part >= 0 && part < m->n_parts && m->parts[part].name[0])
+        snprintf(out, size, "part %d (%s)", part, m->parts[part].name);
+    else
+        snprintf(out, size, "part %d", part);
+}
+
+/* The trust checks of object i at this frame (sem_world_object_checks) into its frame entry
+ * o, and the run's record of the limits passed (docs/scenes.md, "Trust"). */
+static void add_object_checks(run_state *r, int i, int frame, cJSON *o)
+{
+    sem_object_checks c;
+    sem_error err;
+    if (sem_world_object_checks(r->world, i, &c, &err) != SEM_OK) {
+        cJSON_AddStringToObject(o, "checks_error", err.message);
+        return;
+    }
+    cJSON_AddNumberToObject(o, "seam_gap", c.seam_gap_relative);
+    if (c.seam_parts[0] >= 0) {
+        int parts[2] = {c.seam_parts[0], c.seam_parts[1]};
+        cJSON_AddItemToObject(o, "seam_parts", cJSON_CreateIntArray(parts, 2));
+    }
+    cJSON_AddNumberToObject(o, "error_share", c.error_share);
+    cJSON_AddNumberToObject(o, "volume_change", c.volume_change);
+    if (c.seam_gap_relative > r->worst_seam) r->worst_seam = c.seam_gap_relative;
+    if (c.error_share > r->worst_share) r->worst_share = c.error_share;
+    if (fabs(c.volume_change) > fabs(r->worst_volume) || !isfinite(c.volume_change)) r->worst_volume = c.volume_change;
+    const sem_model *m = sem_scene_world_model(r->sw, i);
+    for (int bit = 0; bit < 3; ++bit) {
+        int flag = 1 << bit;
+        if (!(c.suspect & flag) || (r->suspect & flag)) continue;
+        r->suspect |= flag;
+        char *msg = r->suspect_message[bit];
+        size_t size = sizeof r->suspect_message[bit];
+        if (flag == SEM_SUSPECT_SEAM) {
+            char a[96], b[96];
+            part_label(m, c.seam_parts[0], a, sizeof a);
+            part_label(m, c.seam_parts[1], b, sizeof b);
+            snprintf(msg, size,
+                     "object %d, frame %d: the seam between %s and %s opened by %.3g %% of the "
+                     "object's size (limit %g %%): its faces are coming apart; the answer is suspect",
+                     i, frame, a, b, 100 * c.seam_gap_relative, 100 * SEM_SEAM_GAP_LIMIT);
+        } else if (flag == SEM_SUSPECT_ERROR_SHARE) {
+            snprintf(msg, size,
+                     "object %d, frame %d: the error energy (Eq. 16) is %.3g %% of the energy "
+                     "stored (limit %g %%): the polynomials no longer follow the surface; the "
+                     "answer is suspect",
+                     i, frame, 100 * c.error_share, 100 * SEM_ERROR_SHARE_LIMIT);
+        } else {
+            snprintf(msg, size,
+                     "object %d, frame %d: its volume changed by %.3g %% (limit %g %%; smallest "
+                     "det F %.3g): the answer is suspect",
+                     i, frame, 100 * c.volume_change, 100 * SEM_VOLUME_CHANGE_LIMIT, c.min_det_f);
+        }
+        cli_warn("%s", msg);
+    }
+}
+
 static void add_frame_stats(run_state *r, const double *x)
 {
     cJSON *f = cJSON_CreateObject();
@@ -156,6 +228,7 @@ static void add_frame_stats(run_state *r, const double *x)
         cJSON_AddItemToObject(o, "linear_momentum", vec3(st.linear_momentum));
         cJSON_AddItemToObject(o, "angular_momentum", vec3(st.angular_momentum));
         cJSON_AddNumberToObject(o, "kinetic_energy", st.kinetic_energy);
+        add_object_checks(r, i, (int)lround(x[STAT_TIME] / (r->scene->world.dt * r->scene->steps_per_frame)), o);
         cJSON_AddItemToArray(objs, o);
     }
     cJSON_AddItemToArray(r->frames, f);
@@ -211,6 +284,20 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
         cJSON_AddItemToArray(objs, o);
     }
     cJSON_AddStringToObject(s, "status", status);
+    /* the trust checks over every frame written (docs/scenes.md, "Trust") */
+    cJSON *checks = cJSON_AddObjectToObject(s, "checks");
+    cJSON_AddNumberToObject(checks, "seam_gap_max", r->worst_seam);
+    cJSON_AddNumberToObject(checks, "seam_gap_limit", SEM_SEAM_GAP_LIMIT);
+    cJSON_AddNumberToObject(checks, "error_share_max", r->worst_share);
+    cJSON_AddNumberToObject(checks, "error_share_limit", SEM_ERROR_SHARE_LIMIT);
+    if (isfinite(r->worst_volume))
+        cJSON_AddNumberToObject(checks, "volume_change_max", r->worst_volume);
+    else
+        cJSON_AddNullToObject(checks, "volume_change_max");
+    cJSON_AddNumberToObject(checks, "volume_change_limit", SEM_VOLUME_CHANGE_LIMIT);
+    cJSON *why = cJSON_AddArrayToObject(checks, "suspect");
+    for (int bit = 0; bit < 3; ++bit)
+        if (r->suspect & (1 << bit)) cJSON_AddItemToArray(why, cJSON_CreateString(r->suspect_message[bit]));
     /* every number below is SI (metres, kg, s); frame files are in frame_units */
     cJSON_AddStringToObject(s, "units", "SI (m, kg, s)");
     cJSON_AddStringToObject(s, "frame_units", sem_scene_world_file_units(r->sw, 0));
@@ -377,7 +464,7 @@ static int restore_frames(run_state *r, const double **qs, sem_error *err)
 int cmd_run(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL, *resume_dir = NULL;
-    int frames = -1, json = 0, use_cache = 1, quiet = 0, overwrite = 0;
+    int frames = -1, json = 0, use_cache = 1, quiet = 0, overwrite = 0, strict = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--json")) {
             json = 1;
@@ -387,6 +474,8 @@ int cmd_run(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(argv[i], "--overwrite")) {
             overwrite = 1;
+        } else if (!strcmp(argv[i], "--strict")) {
+            strict = 1;
         } else if (!strcmp(argv[i], "--frames")) {
             if (cli_need_values("run", argc, argv, i, 1) != CLI_OK) return CLI_USAGE;
             if (cli_parse_int("run", "--frames", argv[++i], &frames) != CLI_OK) return CLI_USAGE;
@@ -412,6 +501,7 @@ int cmd_run(int argc, char **argv)
                                 "continues (no SCENE, --out, --frames or --overwrite)");
     run_state r;
     memset(&r, 0, sizeof r);
+    r.strict = strict;
     sem_error err;
     sem_status st;
     if (resume_dir) {
@@ -636,6 +726,14 @@ int cmd_run(int argc, char **argv)
             break;
         }
         add_frame_stats(&r, stats);
+        if (r.strict && r.suspect) {
+            for (int bit = 0; bit < 3; ++bit)
+                if (r.suspect & (1 << bit)) {
+                    snprintf(failure, sizeof failure, "--strict: %s", r.suspect_message[bit]);
+                    break;
+                }
+            break;
+        }
         if (stop_signal) {
             stopped_after = f;
             break;
@@ -647,7 +745,7 @@ int cmd_run(int argc, char **argv)
         snprintf(failure, sizeof failure, "%s", ferr.message);
     int sig = stop_signal;
     const char *sig_name = sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : NULL;
-    const char *status = failure[0] ? "failed" : sig ? "interrupted" : "ok";
+    const char *status = failure[0] ? "failed" : sig ? "interrupted" : r.suspect ? "suspect" : "ok";
     if (write_summary(&r, status, failure[0] ? failure : NULL, sig ? sig_name : NULL, json) != CLI_OK)
         goto done;
     if (failure[0]) {

@@ -56,7 +56,7 @@ static const cli_command commands[] = {
      "  IN and OUT: any model format (by extension, as sem convert). The result is refused when\n"
      "  it would exceed what the readers accept (include/sem/limits.h).\n"},
     {"preprocess", cmd_preprocess, "FILE [--order 1|2] [--spacing H | --rays N1 N2 [--axis x|y|z]] [--points-per-interval N] [--alpha A | --sparsity T] [--origins coupled|paper] [--fit auto|parts|origins] [--gamma G] [-E E] [--blend C] [--tessellation N] [--threads N] [--json] [--save OUT] [--no-cache] [--no-modes]", "SEM preprocessing (samples, quadrature, weights, Pi, operators) with Table 1 timings and zero-energy modes", "  --order 1|2 (2)  --spacing H quadrature cell size (automatic: object-frame cells)\n  --rays N1 N2 the paper's explicit ray grid along --axis (x)  --points-per-interval N (automatic)\n  --alpha A (> 0, model units) or --sparsity T in (0,1); neither: alpha = half the median part size\n  --origins coupled|paper (coupled)  --fit auto|parts|origins: one polynomial per part or per origin (auto)\n  --gamma G (default 1000 E / bbox diagonal)  -E, --youngs-modulus E (1e6)\n  --blend C volume consistency stiffness for the mode check (0.02)  --no-modes skip the zero-energy mode check\n  --tessellation N (16)  --threads N (0: OpenMP default)  --json  --save OUT (binary file, versioned)\n  The result goes into the cache sem run reads ($SEM_CACHE_DIR, see sem run --help) unless --no-cache.\n"},
-    {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--overwrite] [--json] [--no-cache] [--quiet] | --resume DIR",
+    {"run", cmd_run, "[SCENE] [--frames N] [--out DIR] [--overwrite] [--strict] [--json] [--no-cache] [--quiet] | --resume DIR [--strict]",
      "simulate a scene and write the animation (NURBS per frame, meshes, USD, summary.json)",
      "  SCENE        a scene file (JSON, see docs/scenes.md); without it the embedded default\n"
      "               scene runs: a rubber beam clamped at x = 0 swinging under gravity\n"
@@ -66,6 +66,9 @@ static const cli_command commands[] = {
      "               its last complete frame; the result is that of an uninterrupted run\n"
      "  --json       print summary.json on stdout        --no-cache recompute the preprocessing\n"
      "  --quiet      no progress output\n"
+     "  --strict     a suspect answer is an error: the run stops at the first frame whose seams\n"
+     "               open, error energy or volume pass their limits (exit 1, frames kept);\n"
+     "               without it such a run ends with status suspect and a warning\n"
      "  Ctrl-C or SIGTERM: the frames so far, animation.usda and summary.json (status\n"
      "  interrupted) are written, exit status 130 / 143. Preprocessed data is cached by model\n"
      "  content and settings in $SEM_CACHE_DIR (default $XDG_CACHE_HOME/sem or ~/.cache/sem),\n"

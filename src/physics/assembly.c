@@ -433,6 +433,43 @@ void sem_stiffness_z_multiply(const sem_object *o, double ca, const double *Ka, 
     sem_shared_add_transpose(o, out, y);
 }
 
+/* F at quadrature point p from the current shared-basis coefficients o->z (Eq. 15):
+ * F = sum_i w_i z_i^T D_p, the weights constant near the point. */
+static inline void point_deformation_gradient(const sem_object *o, int p, double F[9])
+{
+    const sem_csr *W = &o->d->W;
+    int ma = o->ma, n3 = 3 * ma;
+    const double *D = o->point_D + (size_t)p * ma * 3;
+    double zb[27] = {0}; /* sum_i w_i z_i */
+    for (int r = W->row_start[p]; r < W->row_start[p + 1]; ++r) {
+        const double *zi = o->z + (size_t)W->col[r] * ma * 3;
+        double w = W->val[r];
+        for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
+    }
+    for (int dd = 0; dd < 3; ++dd)
+        for (int e = 0; e < 3; ++e) {
+            double f = 0;
+            for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
+            F[dd * 3 + e] = f;
+        }
+}
+
+double sem_deformed_volume(sem_object *o, const double *q, double *min_det)
+{
+    sem_shared_coefficients(o, sem_centered(o, q), o->z);
+    double volume = 0, lowest = INFINITY;
+    for (int p = 0; p < o->n_quad; ++p) {
+        double F[9];
+        point_deformation_gradient(o, p, F);
+        double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                   F[2] * (F[3] * F[7] - F[4] * F[6]);
+        volume += o->d->quad_volume[p] * J;
+        if (J < lowest) lowest = J;
+    }
+    if (min_det) *min_det = o->n_quad > 0 ? lowest : 1.0;
+    return volume;
+}
+
 sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian, double *grad_q,
                                    const sem_fill_target *fill, sem_error *err)
 {
@@ -471,19 +508,8 @@ sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian
                     }
                     int r0 = W->row_start[p], r1 = W->row_start[p + 1];
                     const double *D = o->point_D + (size_t)p * ma * 3;
-                    double zb[27] = {0}; /* sum_i w_i z_i */
-                    for (int r = r0; r < r1; ++r) {
-                        const double *zi = o->z + (size_t)W->col[r] * ma * 3;
-                        double w = W->val[r];
-                        for (int x = 0; x < n3; ++x) zb[x] += w * zi[x];
-                    }
                     double F[9];
-                    for (int dd = 0; dd < 3; ++dd)
-                        for (int e = 0; e < 3; ++e) {
-                            double f = 0;
-                            for (int k = 0; k < ma; ++k) f += zb[k * 3 + dd] * D[k * 3 + e];
-                            F[dd * 3 + e] = f;
-                        }
+                    point_deformation_gradient(o, p, F);
                     double P[9], H[81];
                     double vol = d->quad_volume[p];
                     double psi = sem_material_energy(o->point_material[p], F, P, want_hessian ? H : NULL);

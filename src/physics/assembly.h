@@ -67,6 +67,9 @@ void sem_point_hessian_multiply(const sem_object *o, double c, int minus_rest, c
 /* The q-space stage alone, from the current Kz: K_blocks (and the fill), or, for a
  * structured object, the fill's coefficients. */
 sem_status sem_assemble_stiffness_blocks(sem_object *o, const sem_fill_target *fill, sem_error *err);
+/* sum_p vol_p det F_p: the volume of the deformed body by the quadrature (Eq. 15's F);
+ * *min_det (may be NULL) receives the smallest det F_p. Uses o->z as work. */
+double sem_deformed_volume(sem_object *o, const double *q, double *min_det);
 /* z = pi_shared x (per part ma x 3, coordinates interleaved), x over all control points. */
 void sem_shared_coefficients(const sem_object *o, const double *x, double *z);
 /* y += pi_shared^T z. */

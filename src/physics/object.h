@@ -29,6 +29,7 @@
 
 #include <stddef.h>
 
+#include "sem/measure.h"
 #include "sem/simulation.h"
 
 struct sem_system;
@@ -112,6 +113,9 @@ typedef struct sem_object {
     struct sem_structured_ops *ops;
     double *K0z;               /* Kz at rest (Rayleigh damping; the rest factor) */
     double *point_H, *point_H0; /* q-space: per point 9 x 9 d2psi/dF2 now and at rest */
+    /* the seam monitor (sem/measure.h): built on the first sem_world_object_checks */
+    int seams_built;
+    sem_seams seams;
 } sem_object;
 
 /* Control points in group g. */

@@ -142,6 +142,7 @@ static void object_destroy(sem_object *o)
     free(o->grad_z);
     free(o->Kz);
     free(o->qc);
+    sem_seams_free(&o->seams);
     free(o->grad_z_share);
     free((void *)o->def.point_loads);
     free((void *)o->def.region_loads);
