@@ -21,6 +21,7 @@
 
 #include "contact/collision_mesh.h"
 #include "contact/collision_topology.h"
+#include "geometry/weld_points.h"
 #include "contact/narrow_phase.h"
 #include "sem/primitives.h"
 #include "test_util.h"
@@ -158,7 +159,7 @@ static void test_weld(void)
         }
     }
     sem_error err;
-    CHECK(sem_collision_weld(x, total, 1e-5, weld, &err) == SEM_OK, "weld");
+    CHECK(sem_weld_points(x, total, 1e-5, weld, &err) == SEM_OK, "weld");
     int wrong = 0;
     for (int i = 0; i < n * n; ++i)
         wrong += weld[i] != i || weld[n * n + i] != i || weld[2 * n * n + i] != 2 * n * n + i;

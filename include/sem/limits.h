@@ -64,6 +64,7 @@
 #define SEM_MAX_RAYS_PER_AXIS 4096             /* sem.rays, --rays */
 #define SEM_MAX_POINTS_PER_INTERVAL 10000      /* sem.points_per_interval */
 #define SEM_MAX_BEAM_SECTIONS 10000            /* primitive beam sections */
+#define SEM_MAX_RESOLUTION 1000                /* sem.resolution: patches across the size */
 #define SEM_MAX_FRAMES 100000000               /* frames of one run */
 
 /* ---- IGES ---- */

@@ -54,6 +54,12 @@ typedef struct sem_scene_object {
     sem_preprocess_options sem;
     double blend;              /* sem.blend: sem_object_def.blend (default SEM_DEFAULT_BLEND) */
     int seams;                 /* sem.seams: sem_object_def.seams (default SEM_SEAMS_GEOMETRIC) */
+    int weld;                  /* sem.weld: sem_object_def.weld (default -1: on with
+                                  sem.resolution, else off) */
+    /* sem.resolution R (default 0: off): the accuracy setting. Every part is cut into patches
+     * of at most L / R (L the model's bounding-box diagonal), each with its own polynomial
+     * (sem_model_patches); the frames hold the file's parts, refined at the cuts. */
+    double resolution;
     int has_pin_box;
     double pin_box[6];
     int n_pin_parts;
@@ -177,6 +183,11 @@ const sem_discretization *sem_scene_world_discretization(const sem_scene_world *
  * are written back in them. */
 const char *sem_scene_world_file_units(const sem_scene_world *sw, int object);
 double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object);
+/* The model an object's frames show and its control points for the world's state q: the
+ * simulated model itself, or with sem.resolution the file's parts refined at the patches' cuts
+ * (sem_model_patches). q_frame has 3 x sem_model_control_points(frame model) values. */
+const sem_model *sem_scene_world_frame_model(const sem_scene_world *sw, int object);
+void sem_scene_world_frame_q(const sem_scene_world *sw, int object, const double *q, double *q_frame);
 /* 1 when every object's discretization came from the cache. */
 int sem_scene_world_all_cached(const sem_scene_world *sw);
 /* Zero-energy modes found in an object (sem_world_object_modes), -1 when not looked for;

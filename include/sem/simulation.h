@@ -134,6 +134,17 @@ typedef struct sem_object_def {
      * seam): SEM_SEAMS_GEOMETRIC (0, the default) or SEM_SEAMS_PAPER (docs/refine.md,
      * "Seams"). */
     int seams;
+    /* Welds (1; sem_default_object_def: 0): control points that coincide at rest (within
+     * SEM_WELD_TOLERANCE of the model's size) are held together - where a model was cut into
+     * patches (sem_model_patches), where a B-rep's faces share an edge, at a collapsed edge (a
+     * pole), on the seam of a closed surface - by a tie in the error matrix SEM_WELD_STIFFNESS
+     * times a control point's typical error weight (together to about 1e-6 of the size).
+     * Without them only the error energy (Eq. 16) keeps such seams shut, softly. The ties are
+     * stiff: the sums that conserve momentum and the error energy then carry round-off of
+     * about 1e-5 of their size (1e-7 without), so they are off by default (the paper's
+     * discretization) and on for patches (scene key sem.weld, default: with
+     * sem.resolution). */
+    int weld;
     const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
     sem_prescribe prescribe;             /* motion of every pinned point (all points when
                                             pinned is NULL), unless prescribe_group is given */
@@ -154,6 +165,10 @@ typedef struct sem_object_def {
 } sem_object_def;
 
 #define SEM_DEFAULT_BLEND 0.02
+#define SEM_WELD_TOLERANCE 1e-9
+#ifndef SEM_WELD_STIFFNESS
+#define SEM_WELD_STIFFNESS 1e3
+#endif
 
 /* sem_object_def.seams. PAPER: the residual of the blended map, |sum_i w_i P_i(X) - x|^2,
  * weighted by the sample's area in its knot span (Eq. 16 as written). GEOMETRIC: the

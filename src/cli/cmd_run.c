@@ -98,6 +98,10 @@ typedef struct run_state {
     sem_run_info info;
     unsigned long long run_id;
     size_t *dofs; /* doubles in q per object */
+    /* what the frames show (sem_scene_world_frame_model): per object the world's q, or with
+     * sem.resolution the file's parts gathered from the patches into frame_q */
+    const double **qs;
+    double **frame_q;
     /* the trust checks (sem_world_object_checks) over the frames so far: the worst of each
      * kind, and for each limit passed the first frame and object that passed it */
     double worst_seam, worst_share, worst_volume;
@@ -105,6 +109,14 @@ typedef struct run_state {
     char suspect_message[3][512];     /* per flag bit: the warning of its first frame */
     int strict;                       /* --strict: the first suspect frame fails the run */
 } run_state;
+
+/* r->qs for the world's current state (see run_state). */
+static const double **frame_points(run_state *r)
+{
+    for (int i = 0; i < r->n; ++i)
+        if (r->frame_q[i]) sem_scene_world_frame_q(r->sw, i, sem_world_object_q(r->world, i), r->frame_q[i]);
+    return r->qs;
+}
 
 static void frame_stats(run_state *r, double t, double *x)
 {
@@ -244,7 +256,7 @@ static void add_render_info(run_state *r, int i, cJSON *o)
     int *part_material = NULL;
     sem_material *materials = NULL;
     sem_error err;
-    const sem_model *model = sem_scene_world_model(r->sw, i);
+    const sem_model *model = sem_scene_world_frame_model(r->sw, i);
     if (sem_scene_object_part_materials(&r->scene->objects[i], model, &part_material, &materials, &err) != SEM_OK)
         return;
     cJSON *list = cJSON_AddArrayToObject(o, "part_material");
@@ -360,6 +372,9 @@ static void run_free(run_state *r)
     cJSON_Delete(r->frames);
     sem_scene_destroy(r->scene);
     free(r->dofs);
+    for (int i = 0; r->frame_q && i < r->n; ++i) free(r->frame_q[i]);
+    free(r->frame_q);
+    free(r->qs);
 }
 
 /* Log lines of the scene world: information unless --quiet, warnings always. */
@@ -438,7 +453,7 @@ static sem_status save_state(run_state *r, int frame, const double *stats, sem_e
 
 /* Frames 0..last of a stopped run: their USD points and summary numbers, then the world
  * at frame last. Returns the last complete frame (-1: none) or -2 on an error. */
-static int restore_frames(run_state *r, const double **qs, sem_error *err)
+static int restore_frames(run_state *r, sem_error *err)
 {
     const char *dir = r->scene->output_dir;
     int last = -1;
@@ -455,7 +470,7 @@ static int restore_frames(run_state *r, const double **qs, sem_error *err)
         r->steps = s.steps;
         add_frame_stats(r, s.stats);
         sem_run_frame_state_free(&s);
-        if (sem_animation_restore_frame(r->anim, f, qs, err) != SEM_OK) return -2;
+        if (sem_animation_restore_frame(r->anim, f, frame_points(r), err) != SEM_OK) return -2;
         last = f;
     }
     return last;
@@ -569,7 +584,6 @@ int cmd_run(int argc, char **argv)
                 "rubber beam clamped at x = 0");
     r.frames = cJSON_CreateArray();
     int rc = CLI_FAILED;
-    const double **qs = NULL;
     if (!r.frames) {
         cli_fail("out of memory");
         goto done;
@@ -592,8 +606,9 @@ int cmd_run(int argc, char **argv)
     r.world = sem_scene_world_world(r.sw);
     r.dofs = malloc((size_t)r.n * sizeof *r.dofs);
     const sem_model **models = malloc((size_t)r.n * sizeof *models);
-    qs = malloc((size_t)r.n * sizeof *qs);
-    if (!r.dofs || !models || !qs) {
+    r.qs = malloc((size_t)r.n * sizeof *r.qs);
+    r.frame_q = calloc((size_t)r.n, sizeof *r.frame_q);
+    if (!r.dofs || !models || !r.qs || !r.frame_q) {
         free(models);
         cli_fail("out of memory");
         goto done;
@@ -601,9 +616,18 @@ int cmd_run(int argc, char **argv)
     unsigned long long hashes[64];
     int n_hashes = r.n < 64 ? r.n : 64;
     for (int i = 0; i < r.n; ++i) {
-        models[i] = sem_scene_world_model(r.sw, i);
+        models[i] = sem_scene_world_frame_model(r.sw, i);
         r.dofs[i] = (size_t)sem_world_object_dofs(r.world, i);
-        qs[i] = sem_world_object_q(r.world, i);
+        r.qs[i] = sem_world_object_q(r.world, i);
+        if (models[i] != sem_scene_world_model(r.sw, i)) {
+            r.frame_q[i] = malloc(3 * sem_model_control_points(models[i]) * sizeof(double) + 1);
+            if (!r.frame_q[i]) {
+                free(models);
+                cli_fail("out of memory");
+                goto done;
+            }
+            r.qs[i] = r.frame_q[i];
+        }
         if (i < 64) hashes[i] = sem_scene_world_discretization(r.sw, i)->model_hash;
     }
     if (resume_dir) {
@@ -645,7 +669,7 @@ int cmd_run(int argc, char **argv)
     int first = 1;
     if (resume_dir) {
         sem_error rerr;
-        int last = restore_frames(&r, qs, &rerr);
+        int last = restore_frames(&r, &rerr);
         if (last == -2) {
             cli_fail_error(NULL, &rerr);
             goto done;
@@ -671,7 +695,7 @@ int cmd_run(int argc, char **argv)
         }
         double stats[STAT_COUNT];
         frame_stats(&r, 0.0, stats);
-        if (sem_animation_add_frame(r.anim, 0, qs, &err) != SEM_OK ||
+        if (sem_animation_add_frame(r.anim, 0, frame_points(&r), &err) != SEM_OK ||
             save_state(&r, 0, stats, &err) != SEM_OK) {
             cli_fail_error(NULL, &err);
             goto done;
@@ -720,7 +744,7 @@ int cmd_run(int argc, char **argv)
         }
         double stats[STAT_COUNT];
         frame_stats(&r, sem_world_time(r.world), stats);
-        if (sem_animation_add_frame(r.anim, f, qs, &err) != SEM_OK ||
+        if (sem_animation_add_frame(r.anim, f, frame_points(&r), &err) != SEM_OK ||
             save_state(&r, f, stats, &err) != SEM_OK) {
             snprintf(failure, sizeof failure, "frame %d: %s", f, err.message);
             break;
@@ -776,7 +800,6 @@ int cmd_run(int argc, char **argv)
     rc = CLI_OK;
 done:
     release_stop_signals();
-    free(qs);
     run_free(&r);
     return rc;
 }

@@ -11,6 +11,7 @@
 #include "sem/tessellate.h"
 
 #include "collision_topology.h"
+#include "geometry/weld_points.h"
 #include "narrow_phase.h"
 
 /* Points closer than this x the object size at rest are one point of the surface. */
@@ -323,7 +324,7 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     }
     for (int t = 0; t < 3 * mesh.n_triangles; ++t) out->triangles[t] = used[mesh.triangles[t]];
     update_positions(out, q);
-    if ((st = sem_collision_weld(out->x, out->n_points, WELD_TOLERANCE * out->length, out->weld, err)) != SEM_OK ||
+    if ((st = sem_weld_points(out->x, out->n_points, WELD_TOLERANCE * out->length, out->weld, err)) != SEM_OK ||
         (st = orient_parts(out, &mesh, err)) != SEM_OK)
         goto done;
     update_normals(out); /* of the turned triangles */

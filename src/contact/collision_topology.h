@@ -23,8 +23,6 @@ typedef struct sem_edge_slot {
 } sem_edge_slot;
 int sem_compare_edge_slot(const void *x, const void *y);
 
-/* weld[i] = the lowest index of the points within tol of point i, transitively (x: 3 n). */
-sem_status sem_collision_weld(const double *x, int n, double tol, int *weld, sem_error *err);
 /* edge_other[3 t + e] = the triangle across edge e (from vertex e to vertex e + 1 mod 3) of
  * triangle t, by welded ends; -1 on a boundary or where more than two triangles meet. */
 sem_status sem_collision_edge_neighbours(const int *triangles, int n_triangles, const int *weld, int *edge_other,

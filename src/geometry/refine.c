@@ -114,9 +114,36 @@ sem_status sem_surface_refine(const sem_surface *in, int factor_u, int factor_v,
     if (st == SEM_OK) st = check_factor(factor_v, err);
     if (st == SEM_OK) st = sem_surface_validate(in, err);
     if (st != SEM_OK) return st;
+    const int ru = split_knots(in->degree_u, in->n_u, in->knots_u, factor_u, NULL);
+    const int rv = split_knots(in->degree_v, in->n_v, in->knots_v, factor_v, NULL);
+    double *Xu = malloc(((size_t)ru + 1) * sizeof *Xu);
+    double *Xv = malloc(((size_t)rv + 1) * sizeof *Xv);
+    if (!Xu || !Xv) {
+        free(Xu);
+        free(Xv);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory refining a surface");
+    }
+    split_knots(in->degree_u, in->n_u, in->knots_u, factor_u, Xu);
+    split_knots(in->degree_v, in->n_v, in->knots_v, factor_v, Xv);
+    st = sem_surface_insert_knots(in, Xu, ru, Xv, rv, out, err);
+    free(Xu);
+    free(Xv);
+    return st;
+}
+
+sem_status sem_surface_insert_knots(const sem_surface *in, const double *Xu, int ru, const double *Xv, int rv,
+                                    sem_surface *out, sem_error *err)
+{
+    memset(out, 0, sizeof *out);
+    sem_status st = sem_surface_validate(in, err);
+    if (st != SEM_OK) return st;
     const int pu = in->degree_u, pv = in->degree_v, nu = in->n_u, nv = in->n_v;
-    const int ru = split_knots(pu, nu, in->knots_u, factor_u, NULL);
-    const int rv = split_knots(pv, nv, in->knots_v, factor_v, NULL);
+    for (int k = 0; k < ru; ++k)
+        if (!(Xu[k] > in->knots_u[pu] && Xu[k] < in->knots_u[nu]) || (k > 0 && Xu[k] < Xu[k - 1]))
+            return sem_error_set(err, SEM_ERR_INVALID, "knot %g to insert is outside the u domain or not ascending", Xu[k]);
+    for (int k = 0; k < rv; ++k)
+        if (!(Xv[k] > in->knots_v[pv] && Xv[k] < in->knots_v[nv]) || (k > 0 && Xv[k] < Xv[k - 1]))
+            return sem_error_set(err, SEM_ERR_INVALID, "knot %g to insert is outside the v domain or not ascending", Xv[k]);
     if (ru == 0 && rv == 0) {
         /* nothing to insert: an exact copy, bit for bit (no homogeneous round trip) */
         if (sem_surface_copy(out, in) != SEM_OK)
@@ -124,14 +151,10 @@ sem_status sem_surface_refine(const sem_surface *in, int factor_u, int factor_v,
         return SEM_OK;
     }
     const int mu = nu + ru, mv = nv + rv;
-    double *Xu = malloc(((size_t)ru + 1) * sizeof *Xu);
-    double *Xv = malloc(((size_t)rv + 1) * sizeof *Xv);
     double *hw = malloc((size_t)nu * nv * 4 * sizeof *hw);       /* input, homogeneous */
     double *rows = malloc((size_t)mu * nv * 4 * sizeof *rows);   /* refined in u */
     double *grid = malloc((size_t)mu * mv * 4 * sizeof *grid);   /* refined in u and v */
-    if (!Xu || !Xv || !hw || !rows || !grid || sem_surface_alloc(out, pu, pv, mu, mv) != SEM_OK) {
-        free(Xu);
-        free(Xv);
+    if (!hw || !rows || !grid || sem_surface_alloc(out, pu, pv, mu, mv) != SEM_OK) {
         free(hw);
         free(rows);
         free(grid);
@@ -139,8 +162,6 @@ sem_status sem_surface_refine(const sem_surface *in, int factor_u, int factor_v,
         return sem_error_set(err, SEM_ERR_NOMEM,
                              "out of memory refining a %d x %d surface to %d x %d", nu, nv, mu, mv);
     }
-    split_knots(pu, nu, in->knots_u, factor_u, Xu);
-    split_knots(pv, nv, in->knots_v, factor_v, Xv);
     for (size_t c = 0; c < (size_t)nu * nv; ++c) {
         double w = in->weights[c];
         hw[4 * c] = in->ctrl[3 * c] * w;
@@ -179,8 +200,6 @@ sem_status sem_surface_refine(const sem_surface *in, int factor_u, int factor_v,
     out->closed_v = in->closed_v;
     out->periodic_u = in->periodic_u;
     out->periodic_v = in->periodic_v;
-    free(Xu);
-    free(Xv);
     free(hw);
     free(rows);
     free(grid);

@@ -205,7 +205,9 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
         double tie_weight = 0;
         sem_status st = find_orphans(o, &tie_ctrl, &tie_part, &n_ties, &tie_weight, err);
-        if (st == SEM_OK) st = sem_structured_init(o, Mz, Bz, n_ties, tie_ctrl, tie_part, tie_weight, err);
+        if (st == SEM_OK)
+            st = sem_structured_init(o, Mz, Bz, n_ties, tie_ctrl, tie_part, tie_weight, SEM_WELD_STIFFNESS * tie_weight,
+                                     err);
         o->n_orphans = n_ties;
         free(tie_ctrl);
         free(tie_part);
@@ -269,6 +271,19 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         free(row);
         free(tie_ctrl);
         free(tie_part);
+        /* the welds' ties (object_welds.c): rows e_a - e_b */
+        double wgt = SEM_WELD_STIFFNESS * mean;
+        for (int k = 0; k < o->n_welds; ++k) {
+            const int cc[2] = {o->weld_ctrl[2 * k], o->weld_ctrl[2 * k + 1]};
+            for (int x = 0; x < 2; ++x)
+                for (int y = 0; y < 2; ++y) {
+                    int gx = o->ctrl_group[cc[x]], gy = o->ctrl_group[cc[y]];
+                    int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
+                    size_t nb = sem_group_size(o, gy);
+                    o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[cc[x]] * nb + (size_t)o->ctrl_local[cc[y]]] +=
+                        x == y ? wgt : -wgt;
+                }
+        }
     }
     /* Error matrix (Eq. 16) as a sum of outer products of its rows' residuals r (Gamma_s - J_s,
      * or P_i(X_s) Pi_i - J_s on a split seam: sem_error_rows), so it is positive

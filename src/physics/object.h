@@ -19,6 +19,7 @@
  *   object_layout.c  groups, part pairs, group pairs, block offsets, pi_dense
  *   assembly.c       the shared basis, point lists, z-space work, K_blocks,
  *                    elastic_energy, qc
+ *   object_welds.c   n_welds, weld_ctrl
  *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
  *                    n_orphans
  *   system_layout.c  free_index, n_free, system
@@ -85,6 +86,8 @@ typedef struct sem_object {
     double *me_M, *me_E;
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
+    int n_welds;               /* welded pairs (object_welds.c): weld_ctrl[2k], [2k + 1] */
+    int *weld_ctrl;
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
     double gamma;
@@ -128,6 +131,9 @@ static inline size_t sem_group_size(const sem_object *o, int g)
  * samples), group pairs (from part pairs and the patterns of M and M_eps), block offsets,
  * and zeroed K, K0, M and M_eps blocks. */
 sem_status sem_object_layout_init(sem_object *o, sem_error *err);
+/* object_welds.c: the pairs of control points that coincide at rest (sem_object_def.weld),
+ * each point of a cluster paired with the cluster's lowest index. */
+sem_status sem_object_find_welds(sem_object *o, sem_error *err);
 /* The largest group (at least 1). */
 size_t sem_max_group_size(const sem_object *o);
 

@@ -144,6 +144,14 @@ static sem_status setup_pairs(sem_object *o, sem_error *err)
             int ga = o->ctrl_group[r], gb = o->ctrl_group[d->M.col[e]];
             ADD_GPAIR(ga, gb);
         }
+    /* welded control points (object_welds.c): their tie rows join the error matrix */
+    for (int k = 0; k < o->n_welds; ++k) {
+        int ga = o->ctrl_group[o->weld_ctrl[2 * k]], gb = o->ctrl_group[o->weld_ctrl[2 * k + 1]];
+        ADD_GPAIR(ga, ga);
+        ADD_GPAIR(gb, gb);
+        ADD_GPAIR(ga, gb);
+        ADD_GPAIR(gb, ga);
+    }
 #undef ADD_GPAIR
     o->gpair_offset = malloc(((size_t)o->n_gpairs + 1) * sizeof(size_t));
     if (!o->gpair_offset) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");

@@ -14,7 +14,8 @@
  *             Bb = sum_s a_s g_s^T g_s
  *   K, K0   = P'^T Kz P'     (Kz per part pair in the shared basis, P' = pi_shared; Eq. 15)
  *
- * (The orphan ties of mass_error.c are samples too: J = e_c, g = b(X_c - Xbar) on the part.)
+ * (The orphan ties of mass_error.c are samples too: J = e_c, g = b(X_c - Xbar) on the part;
+ * and so are the welds of object_welds.c: J = e_a - e_b, g = 0.)
  * So the system matrix A = cM M + c M_eps + cK K + cD K0 (c = 2 cE gamma) is
  *
  *   A = c S0 + V^T Mid V,   V = [P; G],   Mid = [[Z, -c I], [-c I, 0]],
@@ -60,11 +61,12 @@ typedef struct sem_structured_ops {
 } sem_structured_ops;
 
 /* structured_operators.c: builds o->ops from the discretization, the pair blocks Mz and Bz
- * of mass_error.c (n_pairs x m x m, or NULL) and the orphan ties (control point, its part,
- * weight). */
+ * of mass_error.c (n_pairs x m x m, or NULL), the orphan ties (control point, its part,
+ * weight) and the welds of o (o->weld_ctrl: rows e_a - e_b of weight weld_weight, no
+ * coefficient part). */
 sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
                                int n_ties, const int *tie_ctrl, const int *tie_part,
-                               double tie_weight, sem_error *err);
+                               double tie_weight, double weld_weight, sem_error *err);
 void sem_structured_free(sem_object *o);
 /* y = cM M x + 2 cE M_eps x + cK K x + cD K0 x over all the object's dofs (x, y: 3 n_ctrl). */
 void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD,

@@ -69,9 +69,9 @@ static sem_status build_P(sem_object *o, sem_structured_ops *s, sem_error *err)
     return SEM_OK;
 }
 
-/* The sample rows (the error rows of sem_error_rows, then ties) and Bb. */
+/* The sample rows (the error rows of sem_error_rows, then ties, then welds) and Bb. */
 static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties, const int *tie_ctrl,
-                                const int *tie_part, double tie_weight, sem_error *err)
+                                const int *tie_part, double tie_weight, double weld_weight, sem_error *err)
 {
     const sem_discretization *d = o->d;
     const sem_csr *J = &d->J_hat, *Ws = &d->W_samples;
@@ -79,7 +79,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     int n_err = 0;
     sem_status st = sem_error_rows(o, &rows, &n_err, err);
     if (st != SEM_OK) return st;
-    int m = o->m, ns = n_err, nr = ns + n_ties;
+    int m = o->m, ns = n_err, nw = o->n_welds, nr = ns + n_ties + nw;
     s->n_rows = nr;
     s->area = malloc(((size_t)nr + 1) * sizeof(double));
     s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
@@ -90,6 +90,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     }
     for (int t = 0; t < ns; ++t) s->area[t] = rows[t].weight;
     for (int t = 0; t < n_ties; ++t) s->area[ns + t] = tie_weight;
+    for (int t = 0; t < nw; ++t) s->area[ns + n_ties + t] = weld_weight;
     s->j_start[0] = s->g_start[0] = 0;
     for (int t = 0; t < ns; ++t) {
         int r = rows[t].sample;
@@ -100,6 +101,10 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     for (int t = 0; t < n_ties; ++t) {
         s->j_start[ns + t + 1] = s->j_start[ns + t] + 1;
         s->g_start[ns + t + 1] = s->g_start[ns + t] + m;
+    }
+    for (int t = ns + n_ties; t < nr; ++t) {
+        s->j_start[t + 1] = s->j_start[t] + 2;
+        s->g_start[t + 1] = s->g_start[t];
     }
     size_t nj = (size_t)s->j_start[nr], ng = (size_t)s->g_start[nr];
     s->j_col = malloc((nj + 1) * sizeof(int));
@@ -143,6 +148,15 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
             s->g_idx[s->g_start[r] + k] = i * m + k;
             s->g_val[s->g_start[r] + k] = b[k];
         }
+    }
+    /* welds: the two points, ascending (rows of J are sorted) */
+    for (int t = 0; t < nw; ++t) {
+        int r = ns + n_ties + t, a = o->weld_ctrl[2 * t], b = o->weld_ctrl[2 * t + 1];
+        int lo = a < b ? a : b, hi = a < b ? b : a;
+        s->j_col[s->j_start[r]] = lo;
+        s->j_val[s->j_start[r]] = lo == a ? 1.0 : -1.0;
+        s->j_col[s->j_start[r] + 1] = hi;
+        s->j_val[s->j_start[r] + 1] = hi == a ? 1.0 : -1.0;
     }
     return SEM_OK;
 }
@@ -239,14 +253,14 @@ static void fill_blocks(const sem_object *o, sem_structured_ops *s, const double
 
 sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
                                int n_ties, const int *tie_ctrl, const int *tie_part,
-                               double tie_weight, sem_error *err)
+                               double tie_weight, double weld_weight, sem_error *err)
 {
     sem_structured_ops *s = calloc(1, sizeof *s);
     if (!s) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     o->ops = s;
     s->r0 = o->n_parts * o->m;
     sem_status st = build_P(o, s, err);
-    if (st == SEM_OK) st = build_samples(o, s, n_ties, tie_ctrl, tie_part, tie_weight, err);
+    if (st == SEM_OK) st = build_samples(o, s, n_ties, tie_ctrl, tie_part, tie_weight, weld_weight, err);
     if (st == SEM_OK) st = build_neighbours(o, s, err);
     if (st != SEM_OK) return st;
     fill_blocks(o, s, Mz_pairs, Bz_pairs);

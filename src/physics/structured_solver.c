@@ -46,6 +46,7 @@
 #include "structured.h"
 
 #include "sem/limits.h"
+#include "util/union_find.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -424,6 +425,26 @@ static sem_status build_F(sem_structured_solver *s, sem_error *err)
  * Ep = U_k Lambda_k^1/2 (P~ = Ep P' on the kept space): F2' = T^T F2 Ep, F3' = Ep^T F3 Ep,
  * B' = F2' - I and the constant Hc = F3' - B'^T B'. */
 #define F1_CUTOFF 1e-12
+/* The blocks F1 is decomposed in: origin groups, joined where a weld ties two of them
+ * (union-find, each block numbered by its first group). block[g] for every group; returns
+ * the number of blocks, -1 when out of memory. */
+static int blocks_of(const sem_object *o, int *block)
+{
+    int ng = o->n_groups, n = 0;
+    int *parent = malloc(((size_t)ng + 1) * sizeof *parent);
+    if (!parent) return -1;
+    for (int g = 0; g < ng; ++g) parent[g] = g;
+    for (int k = 0; k < o->n_welds; ++k)
+        sem_uf_unite(parent, o->ctrl_group[o->weld_ctrl[2 * k]], o->ctrl_group[o->weld_ctrl[2 * k + 1]]);
+    /* a root is the lowest group of its set, so it is numbered before its members */
+    for (int g = 0; g < ng; ++g) {
+        int root = sem_uf_find(parent, g);
+        block[g] = root == g ? n++ : block[root];
+    }
+    free(parent);
+    return n;
+}
+
 static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
 {
     int r = s->r, R = 2 * r;
@@ -448,9 +469,26 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     }
     /* F1 is block diagonal by origin group (S0 by part, P~'s rows of a group over the
      * group's control points), so each group's block is decomposed on its own: T and Ep are
-     * block diagonal too, the kept columns of group g at gcol[g] .. gcol[g + 1] */
+     * block diagonal too, the kept columns of group g at gcol[g] .. gcol[g + 1]. A weld
+     * (object_welds.c) puts a row across two groups into S0, which couples their blocks of
+     * F1: such groups are decomposed together, as one "group" here (blocks_of) */
     const sem_object *o = s->o;
-    int ng = o->n_groups, m = o->m;
+    int m = o->m;
+    int *block = malloc(((size_t)o->n_groups + 1) * sizeof *block);
+    if (!block) {
+        free(U);
+        free(lam);
+        free(dsq);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    int ng = blocks_of(o, block);
+    if (ng < 0) {
+        free(U);
+        free(lam);
+        free(dsq);
+        free(block);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
     s->n_groups = ng;
     s->grow = calloc((size_t)ng + 1, sizeof(int));
     s->grow_list = malloc(((size_t)r + 1) * sizeof(int));
@@ -460,9 +498,10 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
         free(U);
         free(lam);
         free(dsq);
+        free(block);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
-    for (int q = 0; q < r; ++q) s->grow[o->d->part_origin[s->p_first[q] / m] + 1]++;
+    for (int q = 0; q < r; ++q) s->grow[block[o->d->part_origin[s->p_first[q] / m]] + 1]++;
     for (int g = 0; g < ng; ++g) s->grow[g + 1] += s->grow[g];
     {
         int *fill = malloc(((size_t)ng + 1) * sizeof(int));
@@ -470,12 +509,14 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
             free(U);
             free(lam);
             free(dsq);
+            free(block);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
         memcpy(fill, s->grow, (size_t)ng * sizeof(int));
-        for (int q = 0; q < r; ++q) s->grow_list[fill[o->d->part_origin[s->p_first[q] / m]]++] = q;
+        for (int q = 0; q < r; ++q) s->grow_list[fill[block[o->d->part_origin[s->p_first[q] / m]]]++] = q;
         free(fill);
     }
+    free(block);
     /* per group: scaled block into U (row-major rg x rg), eigenvalues into lam; the kept
      * eigenpairs are collected into Ucol / lcol (column j of the whole basis) */
     double *Ucol = calloc(rr + 1, sizeof(double)), *lcol = malloc((size_t)r * sizeof(double) + 1);

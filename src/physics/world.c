@@ -143,6 +143,7 @@ static void object_destroy(sem_object *o)
     free(o->Kz);
     free(o->qc);
     sem_seams_free(&o->seams);
+    free(o->weld_ctrl);
     free(o->grad_z_share);
     free((void *)o->def.point_loads);
     free((void *)o->def.region_loads);
@@ -281,6 +282,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         goto fail;
     }
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
+    if (def->weld && (st = sem_object_find_welds(o, err)) != SEM_OK) goto fail;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
     if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;

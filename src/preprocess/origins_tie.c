@@ -50,6 +50,61 @@ static int pair_by_strength(const void *x, const void *y)
     return pair_by_index(x, y);
 }
 
+sem_status sem_merge_origins(sem_discretization *d, int *merge, sem_error *err)
+{
+    const int no = d->n_origins, np = d->n_parts;
+    int n_new = 0;
+    int *seen = malloc(((size_t)no + 1) * sizeof *seen);
+    int *part_origin = malloc(((size_t)np + 1) * sizeof *part_origin);
+    if (!seen || !part_origin) {
+        free(seen);
+        free(part_origin);
+        return sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
+    }
+    for (int j = 0; j < no; ++j) seen[j] = -1;
+    for (int i = 0; i < np; ++i) {
+        int r = sem_uf_find(merge, d->part_origin[i]);
+        if (seen[r] < 0) seen[r] = n_new++;
+        part_origin[i] = seen[r];
+    }
+    free(seen);
+    if (n_new == no) {
+        free(part_origin);
+        return SEM_OK;
+    }
+    double *X = calloc(3 * (size_t)n_new, sizeof *X);
+    double *A = calloc((size_t)n_new, sizeof *A);
+    if (!X || !A) {
+        free(X);
+        free(A);
+        free(part_origin);
+        return sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
+    }
+    for (int s = 0; s < d->n_samples; ++s) {
+        int o = part_origin[d->sample_part[s]];
+        double a = d->sample_area[s] > 0 ? d->sample_area[s] : 0.0;
+        A[o] += a;
+        for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] += a * d->sample_X[3 * (size_t)s + e];
+    }
+    /* an origin without sample area keeps the position of one of its old origins */
+    for (int i = 0; i < np; ++i) {
+        int o = part_origin[i];
+        if (A[o] > 0 || A[o] < 0) continue;
+        memcpy(X + 3 * (size_t)o, d->origin_X + 3 * (size_t)d->part_origin[i], 3 * sizeof *X);
+        A[o] = -1;
+    }
+    for (int o = 0; o < n_new; ++o)
+        if (A[o] > 0)
+            for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] /= A[o];
+    free(A);
+    free(d->origin_X);
+    free(d->part_origin);
+    d->origin_X = X;
+    d->part_origin = part_origin;
+    d->n_origins = n_new;
+    return SEM_OK;
+}
+
 sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, sem_error *err)
 {
     if (n_ties) *n_ties = 0;
@@ -124,51 +179,7 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
     }
 
     /* renumber the merged origins (by their smallest part) and place them */
-    if (n_pairs > 0) {
-        int n_new = 0;
-        for (int j = 0; j < no; ++j) seen[j] = -1;
-        int *part_origin = malloc((size_t)np * sizeof *part_origin);
-        if (!part_origin) goto nomem;
-        for (int i = 0; i < np; ++i) {
-            int r = sem_uf_find(merge, d->part_origin[i]);
-            if (seen[r] < 0) seen[r] = n_new++;
-            part_origin[i] = seen[r];
-        }
-        if (n_new != no) {
-            double *X = calloc(3 * (size_t)n_new, sizeof *X);
-            double *A = calloc((size_t)n_new, sizeof *A);
-            if (!X || !A) {
-                free(X);
-                free(A);
-                free(part_origin);
-                goto nomem;
-            }
-            for (int s = 0; s < d->n_samples; ++s) {
-                int o = part_origin[d->sample_part[s]];
-                double a = d->sample_area[s] > 0 ? d->sample_area[s] : 0.0;
-                A[o] += a;
-                for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] += a * d->sample_X[3 * (size_t)s + e];
-            }
-            /* an origin without sample area keeps the position of one of its old origins */
-            for (int i = 0; i < np; ++i) {
-                int o = part_origin[i];
-                if (A[o] > 0 || A[o] < 0) continue;
-                memcpy(X + 3 * (size_t)o, d->origin_X + 3 * (size_t)d->part_origin[i], 3 * sizeof *X);
-                A[o] = -1;
-            }
-            for (int o = 0; o < n_new; ++o)
-                if (A[o] > 0)
-                    for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] /= A[o];
-            free(A);
-            free(d->origin_X);
-            free(d->part_origin);
-            d->origin_X = X;
-            d->part_origin = part_origin;
-            d->n_origins = n_new;
-        } else {
-            free(part_origin);
-        }
-    }
+    if (n_pairs > 0 && (st = sem_merge_origins(d, merge, err)) != SEM_OK) goto done;
     goto done;
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");

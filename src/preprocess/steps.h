@@ -104,6 +104,10 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err);
 /* origins_tie.c: merges origins so that no group of touching parts can translate against the
  * rest at no energy (Eq. 15 keeps weights constant); *n_ties counts the merges. */
 sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, sem_error *err);
+/* origins_tie.c: the origins joined by the union-find array merge (over origins) made one:
+ * renumbered by their smallest part, each placed at its parts' area-weighted sample centroid
+ * (without sample area: at one of its old positions). */
+sem_status sem_merge_origins(sem_discretization *d, int *merge, sem_error *err);
 
 /* projection.c: fills Pi (Eq. 7), hierarchical, robust to ill-conditioned fits. */
 sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretization *d,

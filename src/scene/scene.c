@@ -255,7 +255,8 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
 {
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
-                                       "tessellation", "weight_threshold", "origins", "fit", "blend", "seams", NULL};
+                                       "tessellation", "weight_threshold", "origins", "fit", "blend", "seams", "weld",
+                                       "resolution", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -575,6 +576,7 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     obj->material = sem_default_material();
     obj->sem = sem_default_preprocess_options();
     obj->blend = SEM_DEFAULT_BLEND;
+    obj->weld = -1; /* with sem.resolution */
     if ((st = parse_shape(c, o, where, base_dir, obj)) != SEM_OK) return st;
     obj->friction = SEM_DEFAULT_FRICTION;
     if ((st = get_number(c, o, "friction", where, &obj->friction)) != SEM_OK) return st;
@@ -628,6 +630,16 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
                 obj->seams = SEM_SEAMS_PAPER;
             else
                 return fail(c, w2, "must be \"geometric\" or \"paper\"");
+        }
+        if ((st = get_bool(c, s, "weld", w, &obj->weld)) != SEM_OK) return st;
+        const cJSON *res = cJSON_GetObjectItemCaseSensitive(s, "resolution");
+        if (res && !cJSON_IsNull(res)) {
+            if ((st = get_number(c, s, "resolution", w, &obj->resolution)) != SEM_OK) return st;
+            if (!(obj->resolution >= 0) || obj->resolution > SEM_MAX_RESOLUTION) {
+                char w2[300];
+                snprintf(w2, sizeof w2, "%s.resolution", w);
+                return fail(c, w2, "must be in 0..%d or null (got %g)", SEM_MAX_RESOLUTION, obj->resolution);
+            }
         }
         const cJSON *bl = cJSON_GetObjectItemCaseSensitive(s, "blend");
         if (bl && !cJSON_IsNull(bl)) {

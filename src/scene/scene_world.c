@@ -14,6 +14,7 @@
  * The cache folder is a setting (the command line picks it from the environment); nothing
  * here reads the environment or prints: information and warnings go to the log callback.
  */
+#include <math.h>
 #include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -22,12 +23,15 @@
 #include <sys/stat.h>
 
 #include "sem/cache.h"
+#include "sem/refine.h"
 #include "sem/scene.h"
+#include "sem/tessellate.h"
 
 struct sem_scene_world {
     const sem_scene *scene;
     int n;
     sem_model **models;
+    sem_patches *patches;      /* per object: sem.resolution's cut (model NULL: none) */
     sem_discretization **discs;
     unsigned char **pins;
     int **part_material;
@@ -117,6 +121,10 @@ void sem_scene_world_destroy(sem_scene_world *sw)
     for (int i = 0; i < sw->n; ++i) {
         if (sw->discs) sem_discretization_destroy(sw->discs[i]);
         if (sw->models) sem_model_destroy(sw->models[i]);
+        if (sw->patches) {
+            sw->patches[i].model = NULL; /* owned by models[i] */
+            sem_patches_free(&sw->patches[i]);
+        }
         if (sw->pins) free(sw->pins[i]);
         if (sw->part_material) free(sw->part_material[i]);
         if (sw->prescribe_group) free(sw->prescribe_group[i]);
@@ -124,6 +132,7 @@ void sem_scene_world_destroy(sem_scene_world *sw)
         if (sw->materials) free(sw->materials[i]);
     }
     free(sw->models);
+    free(sw->patches);
     free(sw->discs);
     free(sw->pins);
     free(sw->part_material);
@@ -180,6 +189,35 @@ static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scen
     return SEM_OK;
 }
 
+/* sem.resolution: object i's model cut into patches of at most L / resolution (L the
+ * diagonal of its tessellation's box, which follows the trims), which the world simulates;
+ * the patches keep the file's parts for the frames (sem_scene_world_frame_model). */
+static sem_status cut_patches(sem_scene_world *sw, int i, const sem_scene_world_options *o, sem_error *err)
+{
+    const sem_scene_object *so = &sw->scene->objects[i];
+    sem_mesh mesh;
+    memset(&mesh, 0, sizeof mesh);
+    sem_status st = sem_mesh_from_model(sw->models[i], 2, &mesh, err);
+    if (st != SEM_OK) return st;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int v = 0; v < mesh.n_vertices; ++v)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], mesh.positions[3 * v + k]);
+            hi[k] = fmax(hi[k], mesh.positions[3 * v + k]);
+        }
+    sem_mesh_free(&mesh);
+    double L = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(L > 0)) return SEM_OK;
+    double size = L / so->resolution;
+    if ((st = sem_model_patches(sw->models[i], size, &sw->patches[i], err)) != SEM_OK) return st;
+    int parts = sw->models[i]->n_parts;
+    sem_model_destroy(sw->models[i]);
+    sw->models[i] = sw->patches[i].model;
+    logf_(o, 0, "object %d: %d parts cut into %d patches of at most %.3g m (sem.resolution %g)", i, parts,
+          sw->models[i]->n_parts, size, so->resolution);
+    return SEM_OK;
+}
+
 /* Loads object i's model and preprocesses it (or reads the cache). */
 static sem_status prepare_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
                                  sem_error *err)
@@ -196,6 +234,10 @@ static sem_status prepare_object(sem_scene_world *sw, int i, const sem_scene_wor
     if (sw->file_unit_to_meter[i] != 1.0)
         logf_(o, 0, "object %d: model file in %s: simulated in metres (x %g), frames written in %s",
               i, sw->file_units[i], sw->file_unit_to_meter[i], sw->file_units[i]);
+    if (so->resolution > 0) {
+        if ((st = cut_patches(sw, i, o, err)) != SEM_OK) return prefix_error(err, st, name, i, ".sem.resolution: ");
+        model = sw->models[i];
+    }
     logf_(o, 0, "object %d: %d parts, %zu dofs; preprocessing...", i, model->n_parts,
           3 * sem_model_control_points(model));
     int cached = 0;
@@ -247,6 +289,105 @@ static sem_status check_memory(sem_scene_world *sw, const sem_scene_world_option
     return SEM_OK;
 }
 
+/* Part indices of the file (n_file parts) in a selection, as the patches cut from them:
+ * *out (caller frees) lists every patch whose parent is listed. */
+static sem_status patch_list(const sem_patches *p, int n_file, const int *parts, int n, const char *what, int **out,
+                             int *n_out, sem_error *err)
+{
+    *out = NULL;
+    *n_out = 0;
+    if (n == 0) return SEM_OK;
+    for (int k = 0; k < n; ++k)
+        if (parts[k] < 0 || parts[k] >= n_file)
+            return sem_error_set(err, SEM_ERR_INVALID, "%s: part %d does not exist (model has %d parts)", what, parts[k],
+                                 n_file);
+    int np = p->model->n_parts;
+    *out = malloc(((size_t)np + 1) * sizeof **out);
+    if (!*out) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    for (int j = 0; j < np; ++j)
+        for (int k = 0; k < n; ++k)
+            if (p->part_parent[j] == parts[k]) {
+                (*out)[(*n_out)++] = j;
+                break;
+            }
+    return SEM_OK;
+}
+
+/* The scene object with its part selections (pin.parts, part_materials by index, prescribe
+ * groups' parts) turned into the patches of sem.resolution; control point indices refer to
+ * the file's points, which the patches refine, and are refused. release() frees it. */
+typedef struct patched_object {
+    sem_scene_object o;
+    int *pin_parts;
+    sem_scene_part_material *part_materials;
+    sem_scene_prescribe_group *groups;
+    int **group_parts;
+} patched_object;
+
+static void release(patched_object *po)
+{
+    free(po->pin_parts);
+    free(po->part_materials);
+    for (int g = 0; po->group_parts && g < po->o.n_prescribe_groups; ++g) free(po->group_parts[g]);
+    free(po->group_parts);
+    free(po->groups);
+}
+
+static sem_status patch_object(const sem_scene_object *so, const sem_patches *p, int n_file, patched_object *po,
+                               sem_error *err)
+{
+    memset(po, 0, sizeof *po);
+    po->o = *so;
+    int points = so->n_pin_points > 0;
+    for (int g = 0; g < so->n_prescribe_groups; ++g) points |= so->prescribe_groups[g].n_points > 0;
+    if (points)
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "pin.points selects control points of the file, which sem.resolution refines: "
+                             "select by box or parts instead");
+    sem_status st = patch_list(p, n_file, so->pin_parts, so->n_pin_parts, "pin.parts", &po->pin_parts,
+                               &po->o.n_pin_parts, err);
+    if (st != SEM_OK) return st;
+    po->o.pin_parts = po->pin_parts;
+    if (so->n_part_materials > 0) {
+        int np = p->model->n_parts, n = 0;
+        po->part_materials = malloc(((size_t)so->n_part_materials * (size_t)np + 1) * sizeof *po->part_materials);
+        if (!po->part_materials) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int k = 0; k < so->n_part_materials; ++k) {
+            const sem_scene_part_material *pm = &so->part_materials[k];
+            if (pm->part < 0) { /* by name: the patches keep their part's name */
+                po->part_materials[n++] = *pm;
+                continue;
+            }
+            if (pm->part >= n_file)
+                return sem_error_set(err, SEM_ERR_INVALID, "part_materials: part %d does not exist (model has %d parts)",
+                                     pm->part, n_file);
+            for (int j = 0; j < np; ++j)
+                if (p->part_parent[j] == pm->part) {
+                    po->part_materials[n] = *pm;
+                    po->part_materials[n++].part = j;
+                }
+        }
+        po->o.part_materials = po->part_materials;
+        po->o.n_part_materials = n;
+    }
+    if (so->n_prescribe_groups > 0) {
+        po->groups = malloc((size_t)so->n_prescribe_groups * sizeof *po->groups);
+        po->group_parts = calloc((size_t)so->n_prescribe_groups, sizeof *po->group_parts);
+        if (!po->groups || !po->group_parts) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        for (int g = 0; g < so->n_prescribe_groups; ++g) {
+            po->groups[g] = so->prescribe_groups[g];
+            char what[64];
+            snprintf(what, sizeof what, "prescribe[%d].pin.parts", g);
+            st = patch_list(p, n_file, so->prescribe_groups[g].parts, so->prescribe_groups[g].n_parts, what,
+                            &po->group_parts[g], &po->groups[g].n_parts, err);
+            if (st != SEM_OK) return st;
+            po->groups[g].parts = po->group_parts[g];
+        }
+        po->o.prescribe_groups = po->groups;
+    }
+    return SEM_OK;
+}
+
 /* Adds object i (preprocessed by prepare_object) to the world. */
 static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
                              sem_error *err)
@@ -256,11 +397,22 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     const sem_scene_object *so = &scene->objects[i];
     const sem_model *model = sw->models[i];
     sem_status st;
+    patched_object po;
+    memset(&po, 0, sizeof po);
+    if (sw->patches[i].refined) {
+        if ((st = patch_object(so, &sw->patches[i], sw->patches[i].refined->n_parts, &po, err)) != SEM_OK) {
+            release(&po);
+            return prefix_error(err, st, name, i, ".");
+        }
+        so = &po.o;
+    }
     if ((st = sem_scene_object_pins(so, model, &sw->pins[i], err)) != SEM_OK ||
         (st = sem_scene_object_part_materials(so, model, &sw->part_material[i], &sw->materials[i],
                                               err)) != SEM_OK ||
-        (st = sem_scene_object_prescribe_groups(so, model, &sw->prescribe_group[i], err)) != SEM_OK)
+        (st = sem_scene_object_prescribe_groups(so, model, &sw->prescribe_group[i], err)) != SEM_OK) {
+        release(&po);
         return prefix_error(err, st, name, i, ".");
+    }
 
     sem_object_def od = sem_default_object_def();
     od.model = model;
@@ -268,6 +420,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.material = so->material;
     od.blend = so->blend;
     od.seams = so->seams;
+    od.weld = so->weld >= 0 ? so->weld : so->resolution > 0;
     od.part_material = sw->part_material[i];
     od.part_materials = sw->materials[i];
     od.n_part_materials = so->n_part_materials;
@@ -275,7 +428,10 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.prescribe = so->prescribe;
     if (sw->prescribe_group[i]) {
         sw->prescribes[i] = malloc((size_t)so->n_prescribe_groups * sizeof(sem_prescribe));
-        if (!sw->prescribes[i]) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        if (!sw->prescribes[i]) {
+            release(&po);
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+        }
         for (int g = 0; g < so->n_prescribe_groups; ++g)
             sw->prescribes[i][g] = so->prescribe_groups[g].prescribe;
         od.prescribe_group = sw->prescribe_group[i];
@@ -291,6 +447,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.n_region_loads = so->n_region_loads;
     od.friction = so->friction;
     int id = sem_world_add_object(sw->world, &od, err);
+    release(&po);
     if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
     return o->skip_modes ? SEM_OK : check_modes(sw, i, id, o, err);
 }
@@ -337,10 +494,11 @@ sem_status sem_scene_world_create(const sem_scene *scene, const sem_scene_world_
     sw->file_unit_to_meter = calloc(n, sizeof *sw->file_unit_to_meter);
     sw->file_units = calloc(n, sizeof *sw->file_units);
     sw->spurious = malloc(n * sizeof *sw->spurious);
+    sw->patches = calloc(n, sizeof *sw->patches);
     sem_status st = SEM_OK;
     for (size_t k = 0; sw->spurious && k < n; ++k) sw->spurious[k] = -1;
     if (!sw->models || !sw->discs || !sw->pins || !sw->part_material || !sw->prescribe_group ||
-        !sw->prescribes || !sw->materials || !sw->file_unit_to_meter || !sw->file_units || !sw->spurious) {
+        !sw->prescribes || !sw->materials || !sw->file_unit_to_meter || !sw->file_units || !sw->spurious || !sw->patches) {
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -382,6 +540,20 @@ int sem_scene_world_object_count(const sem_scene_world *sw) { return sw ? sw->n 
 const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object)
 {
     return sw && object >= 0 && object < sw->n ? sw->models[object] : NULL;
+}
+
+const sem_model *sem_scene_world_frame_model(const sem_scene_world *sw, int object)
+{
+    if (!sw || object < 0 || object >= sw->n) return NULL;
+    return sw->patches[object].refined ? sw->patches[object].refined : sw->models[object];
+}
+
+void sem_scene_world_frame_q(const sem_scene_world *sw, int object, const double *q, double *q_frame)
+{
+    if (sw->patches[object].refined)
+        sem_patches_gather(&sw->patches[object], q, q_frame);
+    else
+        memcpy(q_frame, q, 3 * sem_model_control_points(sw->models[object]) * sizeof(double));
 }
 
 const sem_discretization *sem_scene_world_discretization(const sem_scene_world *sw, int object)
