@@ -461,6 +461,11 @@ int cmd_run(int argc, char **argv)
             }
         }
     }
+    /* a folder that cannot take the frames is refused now, not after preprocessing */
+    if (sem_animation_check_dir(r.scene->output_dir, &err) != SEM_OK) {
+        run_free(&r);
+        return cli_fail_error(NULL, &err);
+    }
     /* the library reads no environment: the command line turns SEM_DEBUG_NEWTON into the
      * world's trace setting */
     const char *trace = getenv("SEM_DEBUG_NEWTON");

@@ -401,6 +401,34 @@ double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object)
                : 1.0;
 }
 
+sem_status sem_scene_world_frame_model(const sem_scene_world *sw, int object, sem_model **out,
+                                       sem_error *err)
+{
+    if (!out) return sem_error_set(err, SEM_ERR_INVALID, "sem_scene_world_frame_model: no output");
+    *out = NULL;
+    if (!sw || object < 0 || object >= sw->n)
+        return sem_error_set(err, SEM_ERR_INVALID, "object %d of a scene world with %d objects", object,
+                             sw ? sw->n : 0);
+    sem_model *m = sem_model_clone(sw->models[object]);
+    size_t n = 3 * sem_model_control_points(sw->models[object]);
+    double *x = malloc(n * sizeof *x + 1);
+    if (!m || !x) {
+        sem_model_destroy(m);
+        free(x);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    /* the animation writer's arithmetic (output/animation.c), so the numbers are the frame's */
+    const double to_file = 1.0 / sem_scene_world_file_unit_to_meter(sw, object);
+    const double *q = sem_world_object_q(sw->world, object);
+    for (size_t i = 0; i < n; ++i) x[i] = q[i] * to_file;
+    sem_model_set_q(m, x);
+    free(x);
+    snprintf(m->units, sizeof m->units, "%s", sem_scene_world_file_units(sw, object));
+    m->unit_to_meter = sem_scene_world_file_unit_to_meter(sw, object);
+    *out = m;
+    return SEM_OK;
+}
+
 int sem_scene_world_all_cached(const sem_scene_world *sw) { return sw ? sw->all_cached : 0; }
 
 int sem_scene_world_spurious_modes(const sem_scene_world *sw, int object)
