@@ -61,6 +61,34 @@ endif()
 set_target_properties(semlib PROPERTIES EXPORT_NAME sem_static)
 
 # ---- install ----
+# `cmake --install` copies what was built and builds nothing, so after a build of the command
+# alone (`cmake --build build --target sem`) it stopped at the first missing file ("file
+# INSTALL cannot find .../libsem.so.0.1.0"). Its first step builds the installed targets when
+# one of their files is missing (a no-op after a full build).
+set(SEM_INSTALL_TARGETS sem_shared semlib)
+if(TARGET sem)
+  list(APPEND SEM_INSTALL_TARGETS sem)
+endif()
+set(SEM_INSTALL_FILES "")
+foreach(target ${SEM_INSTALL_TARGETS})
+  list(APPEND SEM_INSTALL_FILES "$<TARGET_FILE:${target}>")
+endforeach()
+install(CODE "
+  set(missing \"\")
+  foreach(file ${SEM_INSTALL_FILES})
+    if(NOT EXISTS \"\${file}\")
+      list(APPEND missing \"\${file}\")
+    endif()
+  endforeach()
+  if(missing)
+    message(STATUS \"sem: building what install needs (missing: \${missing})\")
+    execute_process(COMMAND \"${CMAKE_COMMAND}\" --build \"${CMAKE_BINARY_DIR}\"
+                    --target ${SEM_INSTALL_TARGETS} RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR \"sem: building \${missing} failed; run cmake --build ${CMAKE_BINARY_DIR}\")
+    endif()
+  endif()
+")
 install(TARGETS sem_shared semlib EXPORT semTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
