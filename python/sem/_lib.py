@@ -15,7 +15,7 @@ import ctypes
 import ctypes.util
 import glob
 import os
-from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int,
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_float, c_int,
                     c_longlong, c_size_t, c_ulonglong, c_void_p)
 
 
@@ -162,7 +162,8 @@ class sem_part(Structure):
     _c_header_ = "model.h"
     _fields_ = [("name", c_char * 64), ("surface", sem_surface), ("has_outer", c_int),
                 ("outer", sem_trim_loop), ("n_holes", c_int), ("holes", POINTER(sem_trim_loop)),
-                ("source_entity", c_int), ("color", c_int)]
+                ("source_entity", c_int), ("color", c_int), ("has_rgb", c_int),
+                ("rgb", c_float * 3)]
 
 
 class sem_model(Structure):

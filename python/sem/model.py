@@ -106,7 +106,26 @@ class Model:
         s = p.surface
         return {"name": p.name.decode("utf-8", "replace"), "degree": (s.degree_u, s.degree_v),
                 "control_grid": (s.n_u, s.n_v), "trimmed": bool(p.has_outer or p.n_holes),
-                "holes": p.n_holes, "source_entity": p.source_entity}
+                "holes": p.n_holes, "source_entity": p.source_entity,
+                "color": tuple(float(c) for c in p.rgb) if p.has_rgb else None}
+
+    def surface(self, i):
+        """Part i's NURBS surface: degrees (du, dv), control grid (n_u, n_v), knots_u
+        (n_u + du + 1), knots_v, weights (n_v, n_u) (ones when polynomial), the domain
+        (u0, u1, v0, v1) and closed / periodic flags, as numpy copies. Its control points are
+        q()[part_offsets()[i]:part_offsets()[i + 1]], u index fastest."""
+        if not 0 <= i < self.parts:
+            raise IndexError("part %d of a model with %d parts" % (i, self.parts))
+        s = self._p.contents.parts[i].surface
+        n = s.n_u * s.n_v
+        weights = (_copy(s.weights, (s.n_v, s.n_u), np.float64) if s.weights
+                   else np.ones((s.n_v, s.n_u)))
+        return {"degree": (s.degree_u, s.degree_v), "control_grid": (s.n_u, s.n_v),
+                "knots_u": _copy(s.knots_u, (s.n_u + s.degree_u + 1,), np.float64),
+                "knots_v": _copy(s.knots_v, (s.n_v + s.degree_v + 1,), np.float64),
+                "weights": weights, "domain": (s.u0, s.u1, s.v0, s.v1),
+                "closed": (bool(s.closed_u), bool(s.closed_v)),
+                "periodic": (bool(s.periodic_u), bool(s.periodic_v)), "control_points": n}
 
     def part_offsets(self):
         """Index of each part's first control point, plus the total (parts + 1 values)."""
