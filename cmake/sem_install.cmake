@@ -13,6 +13,7 @@
 #   P/lib/cmake/sem/semConfig.cmake ...    find_package(sem): sem::sem (shared), sem::sem_static
 #   P/share/man/man1/sem.1                 the manual page
 #   P/lib/python3.N/dist-packages/sem/     the Python package (cmake/sem_python.cmake)
+#   P/share/sem/sem_blender.zip            the Blender add-on (cmake/sem_blender.cmake)
 # (lib is CMAKE_INSTALL_LIBDIR.) Third-party libraries are linked privately: a program
 # using the shared library links -lsem only.
 
@@ -73,6 +74,10 @@ set(SEM_INSTALL_FILES "")
 foreach(target ${SEM_INSTALL_TARGETS})
   list(APPEND SEM_INSTALL_FILES "$<TARGET_FILE:${target}>")
 endforeach()
+if(TARGET blender_addon)   # cmake/sem_blender.cmake: a zip, not a binary
+  list(APPEND SEM_INSTALL_TARGETS blender_addon)
+  list(APPEND SEM_INSTALL_FILES ${SEM_BLENDER_ZIP})
+endif()
 install(CODE "
   set(missing \"\")
   foreach(file ${SEM_INSTALL_FILES})

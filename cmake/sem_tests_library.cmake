@@ -5,6 +5,7 @@
 #   test_docs_examples  the README's next steps and docs/library.md's C, CMake and Python
 #                       examples, extracted from the documents and run against an install
 #   test_python         the Python package's pytest suite (python/tests)
+#   test_blender        the Blender add-on, headless (tests/blender/run.sh)
 #   test_python_example examples/python/energies.py: a scene stepped, energies plotted
 #   test_occt_*         Open CASCADE as an independent reader (tests/occt_check.cpp)
 # The install and Python tests need unsanitized code (a plain program or python3 cannot
@@ -50,6 +51,16 @@ if(NOT SEM_SANITIZE)
     else()
       message(STATUS "sem: matplotlib missing; test_python_example skipped (Debian: python3-matplotlib)")
     endif()
+  endif()
+
+  # the Blender add-on in Debian's blender, headless, against a fresh install (its zip, the
+  # Python package, libsem, the command); reported as skipped (77) only without blender
+  if(TARGET sem)
+    add_test(NAME test_blender COMMAND sh ${CMAKE_SOURCE_DIR}/tests/blender/run.sh
+      ${CMAKE_COMMAND} ${CMAKE_BINARY_DIR} ${SEM_PYTHON_INSTALL_DIR} ${SEM_SHARED_MODELS}
+      ${CMAKE_BINARY_DIR}/blender-test)
+    set_tests_properties(test_blender PROPERTIES TIMEOUT 300 SKIP_RETURN_CODE 77
+      ENVIRONMENT "OMP_NUM_THREADS=2")
   endif()
 endif()
 

@@ -2,11 +2,12 @@
 test_blender):
 
   blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
-      --zip build/sem_blender.zip --python-dir python --library build/libsem.so \
-      --sem build/sem --models ../shared/models --out build/blender-test
+      --zip P/share/sem/sem_blender.zip --python-dir P/lib/python3.N/dist-packages \
+      --sem P/bin/sem --models ../shared/models --out build/blender-test/run
 
-1. The zip installs and enables as a user would (Preferences > Add-ons > Install), the
-   preferences find the sem package and libsem.
+1. The installed zip installs and enables as a user would (Preferences > Add-ons > Install);
+   with the installed package's folder in the add-on's preferences, the package loads the
+   libsem installed beside it.
 2. rocket.iges (13 parts, millimetres) imports as 13 NURBS surfaces named and coloured as in
    the file, at its real size; Blender's evaluation of each surface is sem's surface.
 3. Pinned at its base (a box), bent by sideways gravity over a ground plane and beside a
@@ -36,8 +37,9 @@ import numpy as np
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 parser = argparse.ArgumentParser()
-for name in ("--zip", "--python-dir", "--library", "--sem", "--models", "--out"):
+for name in ("--zip", "--python-dir", "--sem", "--models", "--out"):
     parser.add_argument(name, required=True)
+parser.add_argument("--library", default="")
 args = parser.parse_args(argv)
 OUT = os.path.abspath(args.out)
 shutil.rmtree(OUT, ignore_errors=True)
@@ -70,10 +72,14 @@ check(os.path.realpath(sem_blender.__file__).startswith(
     "the add-on was not loaded from the installed zip: %s" % sem_blender.__file__)
 prefs = sem_package.preferences()
 prefs.python_path = os.path.abspath(args.python_dir)
-prefs.library_path = os.path.abspath(args.library)
+prefs.library_path = os.path.abspath(args.library) if args.library else ""
 ok, line = sem_package.status()
 check(ok, line)
 sem = sem_package.load_sem()
+if not args.library:
+    prefix = os.path.dirname(os.path.dirname(os.path.abspath(args.sem)))
+    check(os.path.realpath(sem.library_path()).startswith(os.path.realpath(prefix) + os.sep),
+          "the package loaded %s, not the libsem installed in %s" % (sem.library_path(), prefix))
 note("installed from %s; %s" % (os.path.basename(args.zip), line))
 context = bpy.context
 scene = context.scene
