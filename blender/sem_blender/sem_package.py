@@ -60,8 +60,18 @@ def status(context=None):
         sem = load_sem(context)
     except RuntimeError as e:
         return False, str(e)
-    return True, "sem %s, libsem %s, Python package %s" % (
+    line = "sem %s, libsem %s, Python package %s" % (
         sem.version(), sem.library_path(), os.path.dirname(sem.__file__))
+    if _openmp_spins():
+        line += ("; Blender loaded OpenMP with spinning threads first: start it with "
+                 "OMP_WAIT_POLICY=passive for faster steps on a busy machine")
+    return True, line
+
+
+def _openmp_spins():
+    """True when Blender's own libgomp was loaded without a waiting policy from the
+    environment (sem's package asks for passive waiting only for a libgomp it loads)."""
+    return getattr(sys.modules.get("sem._lib"), "openmp_spins", False)
 
 
 class SemAddonPreferences(bpy.types.AddonPreferences):

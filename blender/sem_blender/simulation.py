@@ -48,14 +48,24 @@ def colliders(scene):
             and o.type in ("MESH", "CURVE", "SURFACE", "META", "FONT")]
 
 
+def typed(value):
+    """A setting as the user typed it: Blender keeps properties in single precision (0.01 is
+    0.009999999776), so the shortest decimal that is the same float32 (0.01) goes to sem."""
+    return float(str(np.float32(value)))
+
+
+def typed3(values, scale=1.0):
+    return [typed(v) * scale for v in values]
+
+
 def _pin_box(root, settings, s):
     if settings.pin_box_object is not None:
         box = settings.pin_box_object
         corners = np.array([(box.matrix_world @ _vector(c))[:] for c in box.bound_box])
         low, high = corners.min(axis=0), corners.max(axis=0)
-    else:
-        low = np.minimum(settings.pin_box_min, settings.pin_box_max)
-        high = np.maximum(settings.pin_box_min, settings.pin_box_max)
+        return [[float(x) * s for x in low], [float(x) * s for x in high]]
+    low = np.minimum(typed3(settings.pin_box_min), typed3(settings.pin_box_max))
+    high = np.maximum(typed3(settings.pin_box_min), typed3(settings.pin_box_max))
     return [[float(x) * s for x in low], [float(x) * s for x in high]]
 
 
@@ -147,10 +157,10 @@ def build_scene(context, sem, collider_dir):
         _check_parts_placed(root)
         b = root.sem
         entry = {"model": path,
-                 "material": {"type": b.material, "density": b.density,
-                              "youngs_modulus": b.youngs_modulus,
-                              "poisson_ratio": b.poisson_ratio},
-                 "friction": b.friction}
+                 "material": {"type": b.material, "density": typed(b.density),
+                              "youngs_modulus": typed(b.youngs_modulus),
+                              "poisson_ratio": typed(b.poisson_ratio)},
+                 "friction": typed(b.friction)}
         try:
             transform = geometry.scene_transform(root.matrix_world, s)
         except ValueError as e:
@@ -158,15 +168,15 @@ def build_scene(context, sem, collider_dir):
         if transform:
             entry["transform"] = transform
         if any(b.initial_velocity):
-            entry["initial_velocity"] = [float(v) * s for v in b.initial_velocity]
+            entry["initial_velocity"] = typed3(b.initial_velocity, s)
         if b.pin_mode == "BOX":
             entry["pin"] = {"box": _pin_box(root, b, s)}
         elif b.pin_mode == "VERTEX_GROUP":
             entry["pin"] = {"points": _pin_points(sem, root, b)}
         objects.append(entry)
     out = {"objects": objects,
-           "gravity": [float(g) for g in settings.gravity],
-           "integrator": {"type": settings.integrator, "dt": settings.dt},
+           "gravity": typed3(settings.gravity),
+           "integrator": {"type": settings.integrator, "dt": typed(settings.dt)},
            "frames": settings.frames,
            "steps_per_frame": settings.steps_per_frame}
     walls = []
@@ -177,11 +187,11 @@ def build_scene(context, sem, collider_dir):
         for k, obj in enumerate(obstacles):
             path = os.path.join(collider_dir, "collider_%d.obj" % k)
             _write_collider(obj, depsgraph, path, s)
-            walls.append({"model": path, "friction": obj.sem.friction})
+            walls.append({"model": path, "friction": typed(obj.sem.friction)})
     if settings.ground:
-        walls.append({"plane": {"point": [0.0, 0.0, settings.ground_height * s],
+        walls.append({"plane": {"point": [0.0, 0.0, typed(settings.ground_height) * s],
                                 "normal": [0.0, 0.0, 1.0]},
-                      "friction": settings.ground_friction})
+                      "friction": typed(settings.ground_friction)})
     if walls:
         out["colliders"] = walls
     return out, roots
@@ -209,6 +219,9 @@ class Simulation:
         self.q = []          # per body: one (n, 3) array per frame done, world metres
         self.started = time.monotonic()
         self.seconds = 0.0
+        # (what, start, end) of each libsem call the worker makes: "preprocess" (building the
+        # world) and "step"; tests/blender checks that Python ran in the main thread inside them
+        self.calls = []
         self.thread = threading.Thread(target=self._run, name="sem simulation", daemon=True)
 
     def start(self):
@@ -224,8 +237,10 @@ class Simulation:
 
     def _run(self):
         try:
+            t = time.monotonic()
             world = self.sem.World.from_scene(self.scene, base_dir=self.work_dir,
                                               cache_dir=self.cache_dir, log=self._log)
+            self.calls.append(("preprocess", t, time.monotonic()))
             n = world.object_count
             self.q = [[world.q(i).copy()] for i in range(n)]
             self.phase = "simulating"
@@ -234,7 +249,9 @@ class Simulation:
                     if self.cancel_event.is_set():
                         self.cancelled = True
                         return
+                    t = time.monotonic()
                     world.step()
+                    self.calls.append(("step", t, time.monotonic()))
                 for i in range(n):
                     self.q[i].append(world.q(i).copy())
                 self.frames_done = frame

@@ -56,13 +56,18 @@ def _loaded_already(name):
         return False
 
 
+openmp_spins = False  # True: libgomp was loaded before sem with its spinning default
+
+
 def _load():
     # OpenMP's and OpenBLAS's idle threads spin and fight over the cores unless told
     # otherwise (README: Threads); both read these once, when they are first loaded. If
     # another module loaded libgomp first (matplotlib does), it spins: a time step of the
     # default scene then took 0.9 s instead of 0.05 s on 2 busy cores, so say so.
+    global openmp_spins
     if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
         if _loaded_already("libgomp"):
+            openmp_spins = True
             import warnings
             warnings.warn("sem: OpenMP (libgomp) was loaded before sem with its default "
                           "spinning threads, which can slow sem's steps many times over on a "

@@ -261,26 +261,39 @@ check(any(c == "SEM_PT_body" for c, _ in drawn) and "Part 3" in panel_text(drawn
 context.view_layer.objects.active = root
 
 scene_a = export.export_scene(context, os.path.join(OUT, "a", "scene.json"))
-check(np.allclose(scene_a["objects"][0]["pin"]["box"], [[-1, -1, -1], [1, 1, 0.01]], rtol=1e-7),
-      "pin box %s" % scene_a["objects"][0]["pin"]["box"])  # Blender's floats are float32
+# settings as typed, though Blender holds them in float32
+check(scene_a["objects"][0]["pin"]["box"] == [[-1, -1, -1], [1, 1, 0.01]]
+      and scene_a["integrator"]["dt"] == 0.01 and scene_a["gravity"] == [0, -9.81, 0]
+      and scene_a["objects"][0]["material"]["poisson_ratio"] == 0.45,
+      "settings %s" % scene_a)
 check(len(scene_a["colliders"]) == 2 and "plane" in scene_a["colliders"][1], "colliders")
 
 run = simulation.start(context)
-states, running_panels = [], None
+states, running_panels, beats = [], None, []
 while True:
     state = simulation.tick(context)  # what the modal operator does on each timer event
     states.append(state)
+    beats.append(time.monotonic())
     if state == "RUNNING" and running_panels is None and run.phase == "simulating":
         running_panels = panel_text(draw_panels("running"))
     if state != "RUNNING":
         break
-    time.sleep(0.02)
+    time.sleep(0.005)
 check(state == "FINISHED", "simulation: %s (%s)" % (state, s.status))
+# the interface is not frozen: the main thread ran Python (this loop) inside the worker's
+# libsem calls, which it could not if they held the GIL
+long_calls = [(what, a, b) for what, a, b in run.calls if b - a > 0.05]
+inside = [any(a < t < b for t in beats) for _, a, b in long_calls]
+check(long_calls and sum(inside) >= 0.8 * len(long_calls),
+      "the main thread ran during %d of %d libsem calls longer than 50 ms"
+      % (sum(inside), len(long_calls)))
 check(running_panels is not None and "operator: sem.cancel" in running_panels
       and "prop: progress" in running_panels, "the running panel has no progress and cancel")
 check(states.count("RUNNING") >= 2, "the worker thread was not polled")
-note("simulated 10 frames in the worker thread in %.1f s, polled %d times: %s"
-     % (run.seconds, states.count("RUNNING"), s.status))
+note("simulated 10 frames in the worker thread in %.1f s, polled %d times, the main thread "
+     "running inside %d of the %d libsem calls over 50 ms (%s): %s"
+     % (run.seconds, states.count("RUNNING"), sum(inside), len(long_calls),
+        ", ".join("%s %.2f s" % (w, b - a) for w, a, b in long_calls[:3]) + ", ...", s.status))
 
 
 def sem_run(folder):
