@@ -49,11 +49,12 @@ def register():
     for cls in _CLASSES:
         bpy.utils.register_class(cls)
     properties.register()
+    simulation.register()
     bpy.types.TOPBAR_MT_file_import.append(_menu_import)
 
 
 def unregister():
-    simulation.stop_all()
+    simulation.unregister()
     bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
     properties.unregister()
     for cls in reversed(_CLASSES):

@@ -210,6 +210,7 @@ class Simulation:
         self.cache_dir = cache_dir
         self.work_dir = work_dir
         self.cancel_event = threading.Event()
+        self.forgotten = False
         self.phase = "preprocessing"
         self.frames_done = 0
         self.error = None
@@ -262,6 +263,8 @@ class Simulation:
         finally:
             self.seconds = time.monotonic() - self.started
             self.done = True
+            if self.forgotten:  # nobody will read it: another file was opened
+                shutil.rmtree(self.work_dir, ignore_errors=True)
 
     @property
     def fraction(self):
@@ -299,12 +302,25 @@ def start(context):
 
 
 def active():
+    """The simulation running now (not yet collected by tick), or None."""
     return _active
 
 
 def stop_all():
+    """Cancels the running simulation and forgets it: its results are not applied (another
+    file is being opened, or the add-on is being disabled)."""
+    global _active
     if _active is not None:
+        _active.forgotten = True
         _active.cancel()
+        if _active.done:
+            shutil.rmtree(_active.work_dir, ignore_errors=True)
+        _active = None
+
+
+@bpy.app.handlers.persistent
+def _on_load(*args):
+    stop_all()
 
 
 def _redraw(context):
@@ -548,3 +564,13 @@ class SEM_OT_clear(bpy.types.Operator):
 
 
 CLASSES = (SEM_OT_simulate, SEM_OT_cancel, SEM_OT_clear)
+
+
+def register():
+    bpy.app.handlers.load_pre.append(_on_load)
+
+
+def unregister():
+    stop_all()
+    if _on_load in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_on_load)

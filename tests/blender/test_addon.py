@@ -9,7 +9,8 @@ test_blender):
    with the installed package's folder in the add-on's preferences, the package loads the
    libsem installed beside it.
 2. rocket.iges (13 parts, millimetres) imports as 13 NURBS surfaces named and coloured as in
-   the file, at its real size; Blender's evaluation of each surface is sem's surface.
+   the file, at its real size; Blender's evaluation of each surface is sem's surface. The same
+   model written by sem as STEP and OBJ free-form imports with its 13 parts.
 3. Pinned at its base (a box), bent by sideways gravity over a ground plane and beside a
    mesh collider, 10 frames are simulated in the worker thread, polled as the modal operator
    polls it, while the panels are drawn. The scene the add-on ran is exported and run by
@@ -156,9 +157,9 @@ check(any(line.startswith("label: sem %s" % sem.version()) for line in draw_pref
 
 
 # ------------------------------------------------------------ 2. import as NURBS ----
-def import_rocket(surfaces):
+def import_rocket(surfaces, path=ROCKET):
     before = set(bpy.data.objects)
-    check(bpy.ops.import_scene.sem_model(filepath=ROCKET, surfaces=surfaces) == {"FINISHED"},
+    check(bpy.ops.import_scene.sem_model(filepath=path, surfaces=surfaces) == {"FINISHED"},
           "import failed")
     new = set(bpy.data.objects) - before
     roots = [o for o in new if "sem_model_path" in o]
@@ -231,6 +232,40 @@ check(worst_eval <= 1e-12 * size * 1000, "numpy NURBS evaluation off sem's by %g
 note("import: rocket.iges as 13 NURBS surfaces, names and Steel colour of the file; control "
      "points %.1e m, Blender's surface evaluation %.1e m from sem's (model %.3f m)"
      % (worst, worst_surface, size))
+
+# the same model written by sem as STEP (when sem has Open CASCADE) and OBJ free-form
+formats = []
+for ext in ("step", "obj"):
+    if ext == "step" and not sem.has_step():
+        continue
+    path = os.path.join(OUT, "rocket." + ext)
+    subprocess.run([args.sem, "convert", ROCKET, path], check=True)
+    other = import_rocket("NURBS", path)
+    other_parts = sorted(other.children, key=lambda c: c["sem_part"])
+    check(len(other_parts) == 13 and other["sem_units"] == "MM", "%s: %d parts, %s" % (
+        ext, len(other_parts), other["sem_units"]))
+    kinds = sorted(p["sem_kind"] for p in other_parts)
+    # the surfaces Blender shows span the model's bounding box (Open CASCADE may choose other
+    # control points for the same surface, so the shapes are compared, to Blender's sampling)
+    depsgraph = context.evaluated_depsgraph_get()
+    shown = []
+    for p in other_parts:
+        evaluated = p.evaluated_get(depsgraph)
+        mesh = evaluated.to_mesh()
+        shown.append(np.array([v.co[:] for v in mesh.vertices]))
+        evaluated.to_mesh_clear()
+    shown = np.concatenate(shown)
+    low, high = shown.min(axis=0), shown.max(axis=0)
+    box = model.measure()["bbox"]
+    off = max(np.abs(low - np.array(box[0]) * 0.001).max(), np.abs(high - np.array(box[1]) * 0.001).max())
+    check(off < 1e-3 * size, "%s: the surfaces span %s .. %s, the model %s" % (ext, low, high, box))
+    formats.append("%s (%d NURBS, %d meshes)" % (ext.upper(), kinds.count("NURBS"),
+                                                 kinds.count("MESH")))
+    for obj in [other] + other_parts:
+        bpy.data.objects.remove(obj)
+note("the same model from sem's %s: 13 parts each, spanning its bounding box"
+     % " and ".join(formats))
+context.view_layer.objects.active = root
 
 # ------------------------------------------------------------ 3. simulate (threaded) ----
 s = scene.sem
@@ -448,6 +483,16 @@ note("errors: " + " | ".join(errors))
 bpy.ops.sem.clear()
 check("sem_q" not in root and parts[0].data.shape_keys is None, "Clear Results")
 draw_panels("cleared")
+
+# opening another file while a simulation runs forgets it (its objects are gone)
+root_b.sem.simulate = True
+s.frames = 400
+run = simulation.start(context)
+bpy.ops.wm.read_homefile(use_empty=True)
+check(simulation.active() is None and run.forgotten, "a run outlived its file")
+run.thread.join(60)
+check(run.done and not os.path.exists(run.work_dir), "the forgotten run's folder is left")
+note("opening another file during a run: the run is cancelled and forgotten, its folder removed")
 bpy.ops.preferences.addon_disable(module="sem_blender")
 with open(os.path.join(OUT, "results.txt"), "w") as f:
     f.write("\n".join(results) + "\n")
