@@ -19,6 +19,7 @@
 """
 
 import os
+import re
 import shutil
 import tempfile
 import threading
@@ -204,6 +205,7 @@ class Simulation:
         self.sem = sem
         self.scene = scene
         self.body_names = [r.name for r in roots]
+        self.collider_names = []  # set by start(): collider objects, then "ground"
         self.frames = int(scene["frames"])
         self.steps_per_frame = int(scene["steps_per_frame"])
         self.frame_start = frame_start
@@ -257,7 +259,7 @@ class Simulation:
                     self.q[i].append(world.q(i).copy())
                 self.frames_done = frame
         except self.sem.SemError as e:
-            self.error = str(e)
+            self.error = self.readable(str(e))
         except Exception as e:  # reported in Blender, never lost in the thread
             self.error = "%s: %s" % (type(e).__name__, e)
         finally:
@@ -265,6 +267,18 @@ class Simulation:
             self.done = True
             if self.forgotten:  # nobody will read it: another file was opened
                 shutil.rmtree(self.work_dir, ignore_errors=True)
+
+    def readable(self, message):
+        """sem's message with the scene's keys in Blender's words: "default scene:
+        objects[0].pin.box: ..." becomes "rocket: pin.box: ...", colliders[k] the collider's
+        object name."""
+        def name(match):
+            names = self.body_names if match.group(1) == "objects" else self.collider_names
+            k = int(match.group(2))
+            if k >= len(names):
+                return match.group(0)
+            return names[k] + (": " if match.group(3) else "")
+        return re.sub(r"^(?:[^:\[]*: )?(objects|colliders)\[(\d+)\](\.)?", name, message)
 
     @property
     def fraction(self):
@@ -295,7 +309,9 @@ def start(context):
         shutil.rmtree(work_dir, ignore_errors=True)
         raise
     cache = sem_package.cache_dir(context) if context.scene.sem.use_cache else None
-    _active = Simulation(sem, scene, roots, cache, work_dir, context.scene.frame_start).start()
+    run = Simulation(sem, scene, roots, cache, work_dir, context.scene.frame_start)
+    run.collider_names = [o.name for o in colliders(context.scene)] + ["ground plane"]
+    _active = run.start()
     context.scene.sem.progress = 0.0
     context.scene.sem.status = _active.status()
     return _active

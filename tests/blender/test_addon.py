@@ -475,6 +475,12 @@ parts_b[2].location = (0.1, 0, 0)
 expect_error("part moved alone", "moved on its own",
              lambda: export.export_scene(context, os.path.join(OUT, "c.json")))
 parts_b[2].location = (0, 0, 0)
+b.pin_mode = "BOX"
+b.pin_box_min, b.pin_box_max = (5.0, 5.0, 5.0), (6.0, 6.0, 6.0)
+expect_error("pin box holding nothing",
+             "sem: failed: %s: pin.box: [[5, 5, 5], [6, 6, 6]] contains no control point"
+             % root_b.name, lambda: bpy.ops.sem.simulate())  # sem's message, in Blender's words
+b.pin_mode = "VERTEX_GROUP"
 root_b.sem.simulate = False
 expect_error("nothing to simulate", "nothing to simulate",
              lambda: export.export_scene(context, os.path.join(OUT, "c.json")))
