@@ -13,6 +13,7 @@
 #   P/lib/cmake/sem/semConfig.cmake ...    find_package(sem): sem::sem (shared), sem::sem_static
 #   P/share/man/man1/sem.1                 the manual page
 #   P/lib/python3.N/dist-packages/sem/     the Python package (cmake/sem_python.cmake)
+#   P/share/sem/sem_blender.zip            the Blender add-on (cmake/sem_blender.cmake)
 # (lib is CMAKE_INSTALL_LIBDIR.) Third-party libraries are linked privately: a program
 # using the shared library links -lsem only.
 
@@ -61,6 +62,38 @@ endif()
 set_target_properties(semlib PROPERTIES EXPORT_NAME sem_static)
 
 # ---- install ----
+# `cmake --install` copies what was built and builds nothing, so after a build of the command
+# alone (`cmake --build build --target sem`) it stopped at the first missing file ("file
+# INSTALL cannot find .../libsem.so.0.1.0"). Its first step builds the installed targets when
+# one of their files is missing (a no-op after a full build).
+set(SEM_INSTALL_TARGETS sem_shared semlib)
+if(TARGET sem)
+  list(APPEND SEM_INSTALL_TARGETS sem)
+endif()
+set(SEM_INSTALL_FILES "")
+foreach(target ${SEM_INSTALL_TARGETS})
+  list(APPEND SEM_INSTALL_FILES "$<TARGET_FILE:${target}>")
+endforeach()
+if(TARGET blender_addon)   # cmake/sem_blender.cmake: a zip, not a binary
+  list(APPEND SEM_INSTALL_TARGETS blender_addon)
+  list(APPEND SEM_INSTALL_FILES ${SEM_BLENDER_ZIP})
+endif()
+install(CODE "
+  set(missing \"\")
+  foreach(file ${SEM_INSTALL_FILES})
+    if(NOT EXISTS \"\${file}\")
+      list(APPEND missing \"\${file}\")
+    endif()
+  endforeach()
+  if(missing)
+    message(STATUS \"sem: building what install needs (missing: \${missing})\")
+    execute_process(COMMAND \"${CMAKE_COMMAND}\" --build \"${CMAKE_BINARY_DIR}\"
+                    --target ${SEM_INSTALL_TARGETS} RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR \"sem: building \${missing} failed; run cmake --build ${CMAKE_BINARY_DIR}\")
+    endif()
+  endif()
+")
 install(TARGETS sem_shared semlib EXPORT semTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

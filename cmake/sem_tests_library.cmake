@@ -2,7 +2,10 @@
 #   test_install        install into build/install-test, build tests/install/consumer.c with
 #                       pkg-config and with find_package(sem), run them, and import the
 #                       installed Python package
+#   test_docs_examples  the README's next steps and docs/library.md's C, CMake and Python
+#                       examples, extracted from the documents and run against an install
 #   test_python         the Python package's pytest suite (python/tests)
+#   test_blender        the Blender add-on, headless (tests/blender/run.sh)
 #   test_python_example examples/python/energies.py: a scene stepped, energies plotted
 #   test_occt_*         Open CASCADE as an independent reader (tests/occt_check.cpp)
 # The install and Python tests need unsanitized code (a plain program or python3 cannot
@@ -18,12 +21,23 @@ if(NOT SEM_SANITIZE)
     -DPYTHON_DIR=${SEM_PYTHON_INSTALL_DIR}
     -P ${CMAKE_SOURCE_DIR}/tests/install/install_test.cmake)
   set_tests_properties(test_install PROPERTIES TIMEOUT 300 ENVIRONMENT "OMP_NUM_THREADS=2")
+  # the README's next steps and docs/library.md's examples, extracted and run as written
+  add_test(NAME test_docs_examples COMMAND ${CMAKE_COMMAND}
+    -DBUILD_DIR=${CMAKE_BINARY_DIR} -DSOURCE_DIR=${CMAKE_SOURCE_DIR}
+    -DPREFIX=${CMAKE_BINARY_DIR}/docs-install -DLIBDIR=${CMAKE_INSTALL_LIBDIR}
+    -DVERSION=${PROJECT_VERSION} -DC_COMPILER=${CMAKE_C_COMPILER} -DPYTHON=${SEM_PYTHON_FOUND}
+    -DPYTHON_DIR=${SEM_PYTHON_INSTALL_DIR}
+    -P ${CMAKE_SOURCE_DIR}/tests/install/docs_examples.cmake)
+  set_tests_properties(test_docs_examples PROPERTIES TIMEOUT 300 ENVIRONMENT "OMP_NUM_THREADS=2")
 
   if(SEM_PYTHON_FOUND)
     set(python_env "SEM_LIBRARY=$<TARGET_FILE:sem_shared>" "PYTHONPATH=${CMAKE_SOURCE_DIR}/python"
       "PYTHONDONTWRITEBYTECODE=1" "SEM_SHARED_MODELS=${SEM_SHARED_MODELS}"
       "SEM_TEST_OUTPUT=${CMAKE_BINARY_DIR}/python-test-output" "SEM_SOURCE_DIR=${CMAKE_SOURCE_DIR}"
       "OMP_NUM_THREADS=2" "MPLBACKEND=Agg")
+    if(TARGET sem)
+      list(APPEND python_env "SEM_BINARY=$<TARGET_FILE:sem>")
+    endif()
     add_test(NAME test_python COMMAND ${SEM_PYTHON_FOUND} -m pytest -q -p no:cacheprovider
       ${CMAKE_SOURCE_DIR}/python/tests)
     set_tests_properties(test_python PROPERTIES TIMEOUT 600 ENVIRONMENT "${python_env}")
@@ -37,6 +51,16 @@ if(NOT SEM_SANITIZE)
     else()
       message(STATUS "sem: matplotlib missing; test_python_example skipped (Debian: python3-matplotlib)")
     endif()
+  endif()
+
+  # the Blender add-on in Debian's blender, headless, against a fresh install (its zip, the
+  # Python package, libsem, the command); reported as skipped (77) only without blender
+  if(TARGET sem)
+    add_test(NAME test_blender COMMAND sh ${CMAKE_SOURCE_DIR}/tests/blender/run.sh
+      ${CMAKE_COMMAND} ${CMAKE_BINARY_DIR} ${SEM_PYTHON_INSTALL_DIR} ${SEM_SHARED_MODELS}
+      ${CMAKE_BINARY_DIR}/blender-test)
+    set_tests_properties(test_blender PROPERTIES TIMEOUT 300 SKIP_RETURN_CODE 77
+      ENVIRONMENT "OMP_NUM_THREADS=2")
   endif()
 endif()
 

@@ -35,8 +35,10 @@ fi
 
 skipped=$(cat "$logs"/*.log | grep -c '(Skipped)' || true)
 if [ "$skipped" -gt 0 ]; then
-  echo "test.sh: all run tests passed; $skipped test runs were SKIPPED because the paper's models" \
-       "were not found: set SEM_SHARED_MODELS=/path/to/shared/models (default ../shared/models)"
+  names=$(cat "$logs"/*.log | grep '(Skipped)' | sed 's/.*Test *#[0-9]*: \([^ ]*\).*/\1/' | sort -u | tr '\n' ' ')
+  echo "test.sh: all run tests passed; $skipped test runs were SKIPPED ($names): the paper's" \
+       "models were not found (set SEM_SHARED_MODELS=/path/to/shared/models, default" \
+       "../shared/models), or, for test_blender, there is no blender"
 else
   echo "test.sh: all tests passed, none skipped"
 fi

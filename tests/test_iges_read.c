@@ -152,6 +152,11 @@ static void test_shared_model_details(void)
             CHECK(m->parts[0].surface.knots_u[4] == 0.990062869043284, "knot %.17g",
                   m->parts[0].surface.knots_u[4]);
             CHECK(m->parts[0].color == -213, "colour %d", m->parts[0].color);
+            /* DE 213 is "314,62.7450980392157,62.7450980392157,62.7450980392157,13HSteel" */
+            CHECK(m->parts[0].has_rgb && fabs(m->parts[0].rgb[0] - 0.627450980392157) < 1e-7 &&
+                      m->parts[0].rgb[0] == m->parts[0].rgb[1] && m->parts[0].rgb[1] == m->parts[0].rgb[2],
+                  "rgb %d %g %g %g", m->parts[0].has_rgb, m->parts[0].rgb[0], m->parts[0].rgb[1],
+                  m->parts[0].rgb[2]);
             sem_model_destroy(m);
         }
     }
@@ -173,6 +178,24 @@ static void test_shared_model_details(void)
             for (int i = 0; i < m->n_parts; ++i)
                 trimmed += m->parts[i].has_outer || m->parts[i].n_holes > 0;
             CHECK(trimmed == 0, "castle trimmed parts %d", trimmed);
+            /* four paints (314 at DE 373..379): "314,76.8627450980392,20.7843137254902,
+             * 15.2941176470588,..." is DE 373's; every part has one of them */
+            static const double paint[4][3] = {{76.8627450980392, 20.7843137254902, 15.2941176470588},
+                                               {90.9803921568627, 67.843137254902, 13.7254901960784},
+                                               {18.8235294117647, 23.1372549019608, 58.8235294117647},
+                                               {26.6666666666667, 58.8235294117647, 28.2352941176471}};
+            int painted = 0, used[4] = {0, 0, 0, 0};
+            for (int i = 0; i < m->n_parts; ++i) {
+                const sem_part *p = &m->parts[i];
+                int k = (-p->color - 373) / 2;
+                if (!p->has_rgb || p->color > -373 || p->color < -379 || k < 0 || k > 3) continue;
+                int same = 1;
+                for (int c = 0; c < 3; ++c) same &= fabs(p->rgb[c] - paint[k][c] / 100) < 1e-7;
+                painted += same;
+                used[k] = 1;
+            }
+            CHECK(painted == 28 && used[0] && used[1] && used[2] && used[3],
+                  "castle: %d of 28 parts with their 314 paint's rgb", painted);
             sem_model_destroy(m);
         }
     }

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "sem/model.h"
 #include "sem/primitives.h"
@@ -333,6 +334,52 @@ static void test_bad_scenes(const char *tmp)
     CHECK(rc != 0 && rc != 1, "two scenes: exit %d", rc);
 }
 
+/* An output folder that cannot be written is refused before preprocessing: exit 1, one line
+ * naming the folder and why, nothing preprocessed (the cache stays empty), nothing created.
+ * A folder under a regular file fails for every user; a folder without write permission only
+ * for one who is not root. */
+static void test_unwritable_folder(const char *tmp)
+{
+    char file[512], cache[512], args[2048];
+    snprintf(file, sizeof file, "%s/not_a_folder", tmp);
+    FILE *f = fopen(file, "w");
+    CHECK(f != NULL, "cannot create %s", file);
+    if (f) fclose(f);
+    snprintf(cache, sizeof cache, "%s/cache_unwritable", tmp);
+    const char *saved = getenv("SEM_CACHE_DIR");
+    char saved_cache[512];
+    snprintf(saved_cache, sizeof saved_cache, "%s", saved ? saved : "");
+    setenv("SEM_CACHE_DIR", cache, 1);
+    char locked[512], below[600];
+    snprintf(locked, sizeof locked, "%s/locked", tmp);
+    mkdir(locked, 0555);
+    chmod(locked, 0555);
+    snprintf(below, sizeof below, "%s/out/x", locked);
+    struct {
+        char dir[640];
+        const char *why;
+        int run;
+    } cases[] = {{"", "is not a folder", 1}, {"", "not_a_folder is not a folder", 1}, {"", "Permission denied", geteuid() != 0}};
+    snprintf(cases[0].dir, sizeof cases[0].dir, "%s", file);
+    snprintf(cases[1].dir, sizeof cases[1].dir, "%s/frames/a", file);
+    snprintf(cases[2].dir, sizeof cases[2].dir, "%s", below);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        if (!cases[k].run) continue;
+        snprintf(args, sizeof args, "run --frames 2 --out %s --quiet", cases[k].dir);
+        int rc = test_run_cli(args, g_out, sizeof g_out, g_err, sizeof g_err);
+        int lines, n = sem_lines(g_err, &lines);
+        CHECK(rc == 1 && n == 1 && lines == 1, "unwritable %s: exit %d, want one sem: line: %s", cases[k].dir,
+              rc, g_err);
+        CHECK(strstr(g_err, cases[k].dir) && strstr(g_err, cases[k].why), "message names %s and \"%s\": %s",
+              cases[k].dir, cases[k].why, g_err);
+        struct stat st;
+        CHECK(stat(cache, &st) != 0, "%s: preprocessing ran (the cache %s was written) before the refusal",
+              cases[k].dir, cache);
+    }
+    chmod(locked, 0755);
+    if (saved_cache[0]) setenv("SEM_CACHE_DIR", saved_cache, 1);
+}
+
 /* The patch test example: every control point at A X + b, elastic energy of the uniform
  * stretch F = diag(1.1, 1, 1) with nu = 0: psi = mu/2 (I1 - 3) - mu ln J, mu = E/2. */
 static void check_patch_test(const char *dir)
@@ -422,6 +469,7 @@ int main(void)
     snprintf(cache, sizeof cache, "%s/cache", tmp);
     setenv("SEM_CACHE_DIR", cache, 1);
     test_bad_scenes(tmp);
+    test_unwritable_folder(tmp);
     test_default_scene(tmp);
     test_cache(tmp);
     test_explode(tmp);

@@ -524,9 +524,80 @@ static void test_strict_json(void)
     sem_scene_destroy(s);
 }
 
+/* sem_scene_world_frame_model: the object's model at its state in its file's units. A beam
+ * file read as millimetres ("units": "mm") is simulated in metres (2 mm long), and the frame
+ * model has the state's numbers times 1000 exactly (the animation writer's 1 / 0.001), units
+ * "MM" - what sem run writes in frame_NNNN.igs. A bad object index is an error. */
+static void test_frame_model_units(void)
+{
+    sem_error err;
+    char path[512], json[1024];
+    snprintf(path, sizeof path, "%s/beam_mm.igs", test_tmpdir());
+    sem_model *beam = sem_model_create();
+    sem_beam_def def = sem_default_beam_def();
+    def.length = 2, def.width = 0.4, def.height = 0.4;
+    CHECK(beam && sem_primitive_beam(beam, &def, &err) == SEM_OK && sem_model_save(beam, path, &err) == SEM_OK,
+          "beam file: %s", err.message);
+    sem_model_destroy(beam);
+    snprintf(json, sizeof json,
+             "{\"objects\": [{\"model\": \"%s\", \"units\": \"mm\", \"sem\": {\"order\": 1, \"rays\": [3, 3]},"
+             " \"pin\": {\"box\": [[-1e-5, -1, -1], [1e-5, 1, 1]]}}],"
+             " \"integrator\": {\"type\": \"linearly_implicit_euler\", \"dt\": 0.01}}",
+             path);
+    sem_scene *s = parse(json, &err);
+    CHECK(s != NULL, "scene: %s", s ? "" : err.message);
+    if (!s) return;
+    sem_scene_world_options options = sem_default_scene_world_options();
+    options.skip_modes = 1;
+    sem_scene_world *sw = NULL;
+    CHECK(sem_scene_world_create(s, &options, &sw, &err) == SEM_OK, "world: %s", err.message);
+    if (sw) {
+        sem_world *w = sem_scene_world_world(sw);
+        for (int k = 0; k < 3; ++k) CHECK(sem_world_step(w, &err) == SEM_OK, "step: %s", err.message);
+        sem_model *frame = NULL;
+        CHECK(sem_scene_world_frame_model(sw, 0, &frame, &err) == SEM_OK && frame, "frame model: %s",
+              err.message);
+        if (frame) {
+            size_t n = 3 * sem_model_control_points(frame), off = 0;
+            double *x = malloc(n * sizeof *x);
+            const double *q = sem_world_object_q(w, 0);
+            double lo = INFINITY, hi = -INFINITY, moved = 0;
+            const sem_model *rest = sem_scene_world_model(sw, 0);
+            if (x) {
+                sem_model_get_q(frame, x);
+                for (size_t i = 0; i < n; ++i) off += x[i] != q[i] * (1.0 / 0.001);
+                for (size_t i = 0; i < n; i += 3) {
+                    lo = fmin(lo, q[i]);
+                    hi = fmax(hi, q[i]);
+                }
+                double *r = malloc(n * sizeof *r);
+                if (r) {
+                    sem_model_get_q(rest, r);
+                    for (size_t i = 0; i < n; ++i) moved = fmax(moved, fabs(r[i] - q[i]));
+                    free(r);
+                }
+            }
+            CHECK(x && off == 0, "%zu of %zu frame numbers differ from q x 1000", off, n);
+            CHECK(fabs(hi - lo - 0.002) < 1e-4, "the beam is %g m long, want 0.002", hi - lo);
+            CHECK(moved > 0, "the state did not move");
+            CHECK(!strcmp(frame->units, "MM") && frame->unit_to_meter == 0.001, "units %s %g", frame->units,
+                  frame->unit_to_meter);
+            CHECK(!strcmp(rest->units, "M"), "the simulated model is in metres, not %s", rest->units);
+            free(x);
+            sem_model_destroy(frame);
+        }
+        CHECK(sem_scene_world_frame_model(sw, 1, &frame, &err) == SEM_ERR_INVALID && !frame &&
+                  strstr(err.message, "object 1"),
+              "object 1 of 1: %s", err.message);
+        sem_scene_world_destroy(sw);
+    }
+    sem_scene_destroy(s);
+}
+
 int main(void)
 {
     test_strict_json();
+    test_frame_model_units();
     test_errors();
     test_defaults_and_values();
     test_transform();

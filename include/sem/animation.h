@@ -36,6 +36,13 @@ typedef struct sem_animation_def {
 
 typedef struct sem_animation sem_animation;
 
+/* Whether dir can take the animation, without creating anything: an existing folder this
+ * process may write into, or a path whose first existing ancestor is one (sem_animation_create
+ * makes the missing folders). A program calls it before the long work - `sem run` does before
+ * preprocessing - so a folder it cannot write is refused at once, not after minutes.
+ * SEM_ERR_IO with a message naming the folder and the reason otherwise. */
+sem_status sem_animation_check_dir(const char *dir, sem_error *err);
+
 /* One object per model; the models' topology is fixed, only control points move. */
 sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
                                 const sem_model *const *models, sem_animation **out,

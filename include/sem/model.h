@@ -59,6 +59,8 @@ typedef struct sem_part {
     sem_trim_loop *holes;
     int source_entity;  /* IGES directory entry number of the surface, or 0 */
     int color;          /* IGES colour number (or -DE of a 314), 0 when none */
+    int has_rgb;        /* 1 when the file gives the part a colour: */
+    float rgb[3];       /* red, green, blue in 0..1 (IGES: the colour number's or the 314's) */
 } sem_part;
 
 typedef struct sem_model {

@@ -177,17 +177,27 @@ void sem_scene_world_destroy(sem_scene_world *sw);
 sem_world *sem_scene_world_world(sem_scene_world *sw);
 const sem_scene *sem_scene_world_scene(const sem_scene_world *sw);
 int sem_scene_world_object_count(const sem_scene_world *sw);
+/* The object's model as simulated: in metres, transformed, at rest (the world holds the
+ * moving control points). */
 const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object);
 const sem_discretization *sem_scene_world_discretization(const sem_scene_world *sw, int object);
 /* The units the object's model file was read in (see sem_scene_object_model_units): frames
  * are written back in them. */
 const char *sem_scene_world_file_units(const sem_scene_world *sw, int object);
 double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object);
-/* The model an object's frames show and its control points for the world's state q: the
- * simulated model itself, or with sem.resolution the file's parts refined at the patches' cuts
- * (sem_model_patches). q_frame has 3 x sem_model_control_points(frame model) values. */
-const sem_model *sem_scene_world_frame_model(const sem_scene_world *sw, int object);
-void sem_scene_world_frame_q(const sem_scene_world *sw, int object, const double *q, double *q_frame);
+/* The model an object's frames show, in metres, and its control points for the world's state
+ * q: the simulated model itself, or with sem.resolution the file's parts refined at the
+ * patches' cuts (sem_model_patches). q_out has 3 x sem_model_control_points(output model)
+ * values. */
+const sem_model *sem_scene_world_output_model(const sem_scene_world *sw, int object);
+void sem_scene_world_output_q(const sem_scene_world *sw, int object, const double *q, double *q_out);
+/* A copy of the object's model at its current control points in its file's units (numbers
+ * times 1 / sem_scene_world_file_unit_to_meter, the model's units and unit_to_meter set to
+ * them), exactly what `sem run` writes as a frame: a file saved from it (sem_model_save)
+ * shows the model at its size in a CAD tool, as the run's frame_NNNN.igs does. The world
+ * itself (sem_scene_world_model, sem_world_object_q) is in metres. The caller destroys it. */
+sem_status sem_scene_world_frame_model(const sem_scene_world *sw, int object, sem_model **out,
+                                       sem_error *err);
 /* 1 when every object's discretization came from the cache. */
 int sem_scene_world_all_cached(const sem_scene_world *sw);
 /* Zero-energy modes found in an object (sem_world_object_modes), -1 when not looked for;

@@ -17,12 +17,20 @@ Errors raise sem.SemError with the library's message. The library is found besid
 installed package, or through $SEM_LIBRARY (docs/library.md).
 """
 
+import sys as _sys
+
+try:
+    import numpy as _numpy  # noqa: F401  (every array the package returns is numpy's)
+except ImportError as _e:  # a virtual environment or pyenv without Debian's python3-numpy
+    raise ImportError("numpy is needed: apt-get install python3-numpy (or pip install numpy) "
+                      "(%s: %s)" % (_sys.executable, _e)) from None
+
 from ._lib import SemError, library_path as _library_path, lib as _clib
-from .model import Discretization, Model
+from .model import Discretization, Model, Tessellation
 from .world import ENERGIES, World
 
-__all__ = ["SemError", "Model", "Discretization", "World", "ENERGIES", "version", "has_step",
-           "library_path", "load"]
+__all__ = ["SemError", "Model", "Discretization", "Tessellation", "World", "ENERGIES", "version",
+           "has_step", "library_path", "load"]
 
 
 def version():

@@ -15,7 +15,7 @@ import ctypes
 import ctypes.util
 import glob
 import os
-from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int,
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_float, c_int,
                     c_longlong, c_size_t, c_ulonglong, c_void_p)
 
 
@@ -56,13 +56,18 @@ def _loaded_already(name):
         return False
 
 
+openmp_spins = False  # True: libgomp was loaded before sem with its spinning default
+
+
 def _load():
     # OpenMP's and OpenBLAS's idle threads spin and fight over the cores unless told
     # otherwise (README: Threads); both read these once, when they are first loaded. If
     # another module loaded libgomp first (matplotlib does), it spins: a time step of the
     # default scene then took 0.9 s instead of 0.05 s on 2 busy cores, so say so.
+    global openmp_spins
     if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
         if _loaded_already("libgomp"):
+            openmp_spins = True
             import warnings
             warnings.warn("sem: OpenMP (libgomp) was loaded before sem with its default "
                           "spinning threads, which can slow sem's steps many times over on a "
@@ -162,7 +167,8 @@ class sem_part(Structure):
     _c_header_ = "model.h"
     _fields_ = [("name", c_char * 64), ("surface", sem_surface), ("has_outer", c_int),
                 ("outer", sem_trim_loop), ("n_holes", c_int), ("holes", POINTER(sem_trim_loop)),
-                ("source_entity", c_int), ("color", c_int)]
+                ("source_entity", c_int), ("color", c_int), ("has_rgb", c_int),
+                ("rgb", c_float * 3)]
 
 
 class sem_model(Structure):
@@ -240,11 +246,20 @@ class sem_scene_world_options(Structure):
                 ("memory_available", c_double)]
 
 
+class sem_mesh(Structure):
+    _c_header_ = "tessellate.h"
+    _fields_ = [("n_vertices", c_int), ("n_triangles", c_int), ("positions", POINTER(c_double)),
+                ("normals", POINTER(c_double)), ("uv", POINTER(c_double)),
+                ("triangles", POINTER(c_int)), ("triangle_part", POINTER(c_int)),
+                ("n_parts", c_int), ("part_vertex_start", POINTER(c_int)),
+                ("part_triangle_start", POINTER(c_int))]
+
+
 MIRRORED_STRUCTS = [sem_error, sem_part_measure_result, sem_object_stats, sem_world_advanced,
                     sem_contact_def, sem_world_def,
                     sem_curve, sem_surface, sem_trim_loop, sem_part, sem_model,
                     sem_preprocess_options, sem_preprocess_timings, sem_csr,
-                    sem_discretization, sem_scene, sem_scene_world_options]
+                    sem_discretization, sem_scene, sem_scene_world_options, sem_mesh]
 
 # ---------------------------------------------------------------- prototypes ----
 
@@ -270,6 +285,12 @@ _PROTOTYPES = {
     "sem_model_part_offsets": (None, [_model_p, POINTER(c_size_t)]),
     "sem_model_measure": (c_int, [_model_p, POINTER(sem_part_measure_result),
                                   POINTER(sem_part_measure_result), _err]),
+    # triangle meshes (sem/tessellate.h)
+    "sem_mesh_template_build": (c_int, [_model_p, c_int, POINTER(c_void_p), _err]),
+    "sem_mesh_template_destroy": (None, [c_void_p]),
+    "sem_mesh_template_mesh": (c_int, [c_void_p, POINTER(sem_mesh), _err]),
+    "sem_mesh_update": (c_int, [c_void_p, _model_p, POINTER(sem_mesh), _err]),
+    "sem_mesh_free": (None, [POINTER(sem_mesh)]),
     # preprocessing
     "sem_default_preprocess_options": (sem_preprocess_options, []),
     "sem_preprocess": (c_int, [_model_p, POINTER(sem_preprocess_options), POINTER(_disc_p), _err]),
@@ -289,6 +310,9 @@ _PROTOTYPES = {
     "sem_scene_world_object_count": (c_int, [_scene_world]),
     "sem_scene_world_model": (_model_p, [_scene_world, c_int]),
     "sem_scene_world_discretization": (_disc_p, [_scene_world, c_int]),
+    "sem_scene_world_frame_model": (c_int, [_scene_world, c_int, POINTER(_model_p), _err]),
+    "sem_scene_world_file_units": (c_char_p, [_scene_world, c_int]),
+    "sem_scene_world_file_unit_to_meter": (c_double, [_scene_world, c_int]),
     "sem_scene_world_all_cached": (c_int, [_scene_world]),
     "sem_scene_world_preprocess_seconds": (c_double, [_scene_world]),
     # worlds

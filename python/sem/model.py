@@ -106,7 +106,26 @@ class Model:
         s = p.surface
         return {"name": p.name.decode("utf-8", "replace"), "degree": (s.degree_u, s.degree_v),
                 "control_grid": (s.n_u, s.n_v), "trimmed": bool(p.has_outer or p.n_holes),
-                "holes": p.n_holes, "source_entity": p.source_entity}
+                "holes": p.n_holes, "source_entity": p.source_entity,
+                "color": tuple(float(c) for c in p.rgb) if p.has_rgb else None}
+
+    def surface(self, i):
+        """Part i's NURBS surface: degrees (du, dv), control grid (n_u, n_v), knots_u
+        (n_u + du + 1), knots_v, weights (n_v, n_u) (ones when polynomial), the domain
+        (u0, u1, v0, v1) and closed / periodic flags, as numpy copies. Its control points are
+        q()[part_offsets()[i]:part_offsets()[i + 1]], u index fastest."""
+        if not 0 <= i < self.parts:
+            raise IndexError("part %d of a model with %d parts" % (i, self.parts))
+        s = self._p.contents.parts[i].surface
+        n = s.n_u * s.n_v
+        weights = (_copy(s.weights, (s.n_v, s.n_u), np.float64) if s.weights
+                   else np.ones((s.n_v, s.n_u)))
+        return {"degree": (s.degree_u, s.degree_v), "control_grid": (s.n_u, s.n_v),
+                "knots_u": _copy(s.knots_u, (s.n_u + s.degree_u + 1,), np.float64),
+                "knots_v": _copy(s.knots_v, (s.n_v + s.degree_v + 1,), np.float64),
+                "weights": weights, "domain": (s.u0, s.u1, s.v0, s.v1),
+                "closed": (bool(s.closed_u), bool(s.closed_v)),
+                "periodic": (bool(s.periodic_u), bool(s.periodic_v)), "control_points": n}
 
     def part_offsets(self):
         """Index of each part's first control point, plus the total (parts + 1 values)."""
@@ -145,6 +164,12 @@ class Model:
         """Writes the model in the format of path's extension (written atomically)."""
         err = _lib.new_error()
         check(lib.sem_model_save(self._p, encode(path), ctypes.byref(err)), err)
+
+    def tessellate(self, resolution=6):
+        """Triangle mesh of the (trimmed) parts, resolution x resolution cells per knot span
+        (sem/tessellate.h; sem run's frame meshes use output.mesh_resolution, 6): a Tessellation
+        whose update(model) gives the positions for moved control points."""
+        return Tessellation(self, resolution)
 
     def preprocess(self, **settings):
         """SEM preprocessing (paper Sec. 5-6) with the keys of a scene's "sem" object:
@@ -187,6 +212,80 @@ class Model:
             return "<sem.Model closed>"
         return "<sem.Model %d parts, %d control points, units %s>" % (
             self.parts, self.control_points, self.units[0])
+
+
+class Tessellation:
+    """A model's triangle mesh (sem/tessellate.h). The topology (triangles, uv, parts) and the
+    basis rows are built once; update(model) forms the positions and normals for a model with
+    the same parts, knots and weights and new control points (an animation's frames).
+
+    Arrays are numpy copies: positions, normals (n_vertices, 3); uv (n_vertices, 2);
+    triangles (n_triangles, 3), counter-clockwise in (u,v); triangle_part (n_triangles,);
+    part_vertex_start, part_triangle_start (parts + 1): part i's vertices are
+    positions[part_vertex_start[i]:part_vertex_start[i + 1]]."""
+
+    def __init__(self, model, resolution=6):
+        resolution = int(resolution)
+        if not 1 <= resolution <= 256:
+            raise ValueError("resolution: cells per knot span, 1..256 (not %d)" % resolution)
+        self._template = None
+        self._mesh = _lib.sem_mesh()
+        self._has_mesh = False
+        err = _lib.new_error()
+        template = ctypes.c_void_p()
+        check(lib.sem_mesh_template_build(model._p, resolution, ctypes.byref(template),
+                                          ctypes.byref(err)), err)
+        self._template = template
+        check(lib.sem_mesh_template_mesh(template, ctypes.byref(self._mesh), ctypes.byref(err)),
+              err)
+        self._has_mesh = True
+        m = self._mesh
+        self.resolution = resolution
+        self.parts = m.n_parts
+        self.triangles = _copy(m.triangles, (m.n_triangles, 3), np.int32)
+        self.triangle_part = _copy(m.triangle_part, (m.n_triangles,), np.int32)
+        self.uv = _copy(m.uv, (m.n_vertices, 2), np.float64)
+        self.part_vertex_start = _copy(m.part_vertex_start, (m.n_parts + 1,), np.int32)
+        self.part_triangle_start = _copy(m.part_triangle_start, (m.n_parts + 1,), np.int32)
+        self.update(model)
+
+    def update(self, model):
+        """Positions and normals for `model`'s control points (the same parts, knots and
+        weights as the model the mesh was built from); returns positions."""
+        if model.parts != self.parts:
+            raise ValueError("the model has %d parts, the mesh was built for %d"
+                             % (model.parts, self.parts))
+        err = _lib.new_error()
+        check(lib.sem_mesh_update(self._template, model._p, ctypes.byref(self._mesh),
+                                  ctypes.byref(err)), err)
+        m = self._mesh
+        self.positions = _copy(m.positions, (m.n_vertices, 3), np.float64)
+        self.normals = _copy(m.normals, (m.n_vertices, 3), np.float64)
+        return self.positions
+
+    def close(self):
+        if getattr(self, "_has_mesh", False):
+            lib.sem_mesh_free(ctypes.byref(self._mesh))
+            self._has_mesh = False
+        if getattr(self, "_template", None):
+            lib.sem_mesh_template_destroy(self._template)
+            self._template = None
+
+    def __del__(self):
+        self.close()
+
+    def __repr__(self):
+        return "<sem.Tessellation %d vertices, %d triangles, %d parts>" % (
+            len(self.uv), len(self.triangles), self.parts)
+
+
+def _copy(pointer, shape, dtype):
+    n = int(np.prod(shape))
+    if n == 0 or not pointer:
+        return np.zeros(shape, dtype=dtype)
+    ctype = ctypes.c_double if dtype == np.float64 else ctypes.c_int
+    buffer = ctypes.cast(pointer, ctypes.POINTER(ctype * n)).contents
+    return np.frombuffer(buffer, dtype=dtype, count=n).reshape(shape).copy()
 
 
 _OPTION_FIELDS = {"order", "spacing", "points_per_interval", "alpha", "sparsity",

@@ -261,12 +261,23 @@ class World:
 
     # ---- models ----
     def model(self, i=0):
-        """A copy of object i's model with its current control points (save() it to write a
-        frame: sem.World...model(0).save("frame.igs"))."""
+        """A copy of object i's model at its current control points, in the units of its file
+        (model.units), with the numbers `sem run` writes in frame_NNNN.igs: save() it to write
+        a frame (world.model(0).save("frame.igs")). world.q(i) is the state, in metres."""
         i = self._object(i)
-        m = Model(lib.sem_model_clone(lib.sem_scene_world_model(self._h.scene_world, i)))
-        m.set_q(self.q(i))
-        return m
+        err = _lib.new_error()
+        out = _lib._model_p()
+        check(lib.sem_scene_world_frame_model(self._h.scene_world, i, ctypes.byref(out),
+                                              ctypes.byref(err)), err)
+        return Model(out)
+
+    def units(self, i=0):
+        """The units of object i's file, (name, metres per unit): those of world.model(i) and
+        of sem run's frames. Everything else (q, v, stats, the scene) is SI."""
+        i = self._object(i)
+        sw = self._h.scene_world
+        return (lib.sem_scene_world_file_units(sw, i).decode(),
+                lib.sem_scene_world_file_unit_to_meter(sw, i))
 
     def discretization(self, i=0):
         """Object i's discretization (owned by the world; its arrays are views)."""

@@ -69,12 +69,14 @@ def py_fields(cls):
     for name, t in cls._fields_:
         length = 0
         if issubclass(t, ctypes.Array) and t._type_ in (ctypes.c_char, ctypes.c_double,
-                                                         ctypes.c_int):
+                                                         ctypes.c_float, ctypes.c_int):
             length, t = t._length_, t._type_
         if t is ctypes.c_int:
             kind = "int"
         elif t is ctypes.c_double:
             kind = "double"
+        elif t is ctypes.c_float:
+            kind = "float"
         elif t is ctypes.c_char:
             kind = "char"
         elif t is ctypes.c_ulonglong:

@@ -103,3 +103,24 @@ def test_step_support_is_reported():
         with pytest.raises(sem.SemError) as e:
             sem.load("x.step")
         assert "not supported by this build" in str(e.value)
+
+
+def test_tessellation_matches_the_model_and_follows_its_control_points():
+    """A 1 x 2 x 3 box's triangle mesh: its area tends to 22 (flat faces: exactly), its
+    vertices lie on the faces, and moving the control points moves the mesh the same way."""
+    m = sem.Model.primitive("box", size=[1, 2, 3])
+    t = m.tessellate(4)
+    assert t.parts == 6 and len(t.part_vertex_start) == 7
+    p = t.positions
+    tri = t.triangles
+    area = 0.5 * np.linalg.norm(np.cross(p[tri[:, 1]] - p[tri[:, 0]],
+                                         p[tri[:, 2]] - p[tri[:, 0]]), axis=1).sum()
+    assert abs(area - 22.0) < 1e-9
+    assert np.allclose(np.abs(p).max(axis=0), [0.5, 1, 1.5], atol=1e-12)
+    assert t.uv.shape == (len(p), 2) and t.triangle_part.shape == (len(tri),)
+    assert np.all(np.diff(t.part_vertex_start) > 0)
+    moved = m.copy()
+    moved.set_q(2.0 * m.q() + [1.0, 0, 0])
+    assert np.allclose(t.update(moved), 2.0 * p + [1.0, 0, 0], atol=1e-12)
+    with pytest.raises(ValueError):
+        m.tessellate(0)

@@ -98,7 +98,7 @@ typedef struct run_state {
     sem_run_info info;
     unsigned long long run_id;
     size_t *dofs; /* doubles in q per object */
-    /* what the frames show (sem_scene_world_frame_model): per object the world's q, or with
+    /* what the frames show (sem_scene_world_output_model): per object the world's q, or with
      * sem.resolution the file's parts gathered from the patches into frame_q */
     const double **qs;
     double **frame_q;
@@ -114,7 +114,7 @@ typedef struct run_state {
 static const double **frame_points(run_state *r)
 {
     for (int i = 0; i < r->n; ++i)
-        if (r->frame_q[i]) sem_scene_world_frame_q(r->sw, i, sem_world_object_q(r->world, i), r->frame_q[i]);
+        if (r->frame_q[i]) sem_scene_world_output_q(r->sw, i, sem_world_object_q(r->world, i), r->frame_q[i]);
     return r->qs;
 }
 
@@ -256,7 +256,7 @@ static void add_render_info(run_state *r, int i, cJSON *o)
     int *part_material = NULL;
     sem_material *materials = NULL;
     sem_error err;
-    const sem_model *model = sem_scene_world_frame_model(r->sw, i);
+    const sem_model *model = sem_scene_world_output_model(r->sw, i);
     if (sem_scene_object_part_materials(&r->scene->objects[i], model, &part_material, &materials, &err) != SEM_OK)
         return;
     cJSON *list = cJSON_AddArrayToObject(o, "part_material");
@@ -566,6 +566,11 @@ int cmd_run(int argc, char **argv)
             }
         }
     }
+    /* a folder that cannot take the frames is refused now, not after preprocessing */
+    if (sem_animation_check_dir(r.scene->output_dir, &err) != SEM_OK) {
+        run_free(&r);
+        return cli_fail_error(NULL, &err);
+    }
     /* the library reads no environment: the command line turns SEM_DEBUG_NEWTON into the
      * world's trace setting */
     const char *trace = getenv("SEM_DEBUG_NEWTON");
@@ -616,7 +621,7 @@ int cmd_run(int argc, char **argv)
     unsigned long long hashes[64];
     int n_hashes = r.n < 64 ? r.n : 64;
     for (int i = 0; i < r.n; ++i) {
-        models[i] = sem_scene_world_frame_model(r.sw, i);
+        models[i] = sem_scene_world_output_model(r.sw, i);
         r.dofs[i] = (size_t)sem_world_object_dofs(r.world, i);
         r.qs[i] = sem_world_object_q(r.world, i);
         if (models[i] != sem_scene_world_model(r.sw, i)) {

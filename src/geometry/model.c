@@ -165,6 +165,8 @@ sem_status sem_part_copy(sem_part *dst, const sem_part *src)
     dst->has_outer = src->has_outer;
     dst->source_entity = src->source_entity;
     dst->color = src->color;
+    dst->has_rgb = src->has_rgb;
+    memcpy(dst->rgb, src->rgb, sizeof dst->rgb);
     if (sem_surface_copy(&dst->surface, &src->surface) != SEM_OK) goto fail;
     if (loop_copy(&dst->outer, &src->outer) != SEM_OK) goto fail;
     if (src->n_holes > 0) {

@@ -46,6 +46,7 @@
  */
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -1876,6 +1877,30 @@ static int label_name(const iges_reader *r, int idx, char *name, size_t size)
     return 1;
 }
 
+/* An IGES colour as red, green, blue in 0..1: a colour number (1 black, 2 red, 3 green,
+ * 4 blue, 5 yellow, 6 magenta, 7 cyan, 8 white) or -DE of a 314 colour definition (its first
+ * three parameters: percentages). Returns 0 when there is none or it cannot be read: a colour
+ * is not worth refusing a file. */
+static int color_rgb(const iges_reader *r, int color, float rgb[3])
+{
+    static const float numbered[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1},
+                                         {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+    if (color >= 1 && color <= 8) {
+        memcpy(rgb, numbered[color - 1], sizeof numbered[0]);
+        return 1;
+    }
+    if (color >= 0 || color == INT_MIN || (-color) % 2 == 0) return 0;
+    int idx = (-color - 1) / 2;
+    if (idx >= r->n_entries || r->entries[idx].type != 314 || r->entries[idx].n_params < 4) return 0;
+    for (int k = 0; k < 3; ++k) {
+        const iges_token *t = &r->tokens[r->entries[idx].first_token + (size_t)(k + 1)];
+        double percent;
+        if (t->is_string || parse_real(r->ptext + t->offset, t->length, 0.0, &percent) != 1) return 0;
+        rgb[k] = (float)(percent < 0 ? 0 : percent > 100 ? 1 : percent / 100);
+    }
+    return 1;
+}
+
 /* Names, colour and source, then the checks every part must pass, then into the model. */
 static sem_status finish_part(iges_reader *r, sem_part *part, int top, int surf)
 {
@@ -1885,6 +1910,7 @@ static sem_status finish_part(iges_reader *r, sem_part *part, int top, int surf)
         label_name(r, surf, part->name, sizeof part->name);
     part->source_entity = de_number(surf);
     part->color = r->entries[top].color ? r->entries[top].color : r->entries[surf].color;
+    part->has_rgb = color_rgb(r, part->color, part->rgb);
     if (r->model->n_parts >= SEM_MAX_PARTS) {
         sem_part_free(part);
         return entity_error(r, top, 0, "the model would have more than %d parts (limit "

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "gltf.h"
 #include "io/atomic_file.h"
@@ -47,6 +48,41 @@ static sem_status make_dirs(const char *path, sem_error *err)
     if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
         return sem_error_set(err, SEM_ERR_IO, "%s: cannot create folder: %s", tmp, strerror(errno));
     return SEM_OK;
+}
+
+sem_status sem_animation_check_dir(const char *dir, sem_error *err)
+{
+    if (!dir || !dir[0]) return sem_error_set(err, SEM_ERR_INVALID, "no output folder given");
+    char path[4096];
+    if (strlen(dir) >= sizeof path)
+        return sem_error_set(err, SEM_ERR_INVALID, "output folder name too long (%zu characters)", strlen(dir));
+    snprintf(path, sizeof path, "%s", dir);
+    for (;;) {
+        size_t n = strlen(path);
+        while (n > 1 && path[n - 1] == '/') path[--n] = '\0';
+        struct stat st;
+        if (stat(path, &st) == 0) {
+            if (!S_ISDIR(st.st_mode))
+                return sem_error_set(err, SEM_ERR_IO, "%s: cannot write the output there: %s is not a folder",
+                                     dir, path);
+            if (access(path, W_OK | X_OK) != 0)
+                return sem_error_set(err, SEM_ERR_IO, "%s: cannot write the output there: %s: %s", dir,
+                                     path, strerror(errno));
+            return SEM_OK;
+        }
+        /* ENOTDIR: a file on the way, which the walk up finds and names */
+        if ((errno != ENOENT && errno != ENOTDIR) || !strcmp(path, "."))
+            return sem_error_set(err, SEM_ERR_IO, "%s: cannot write the output there: %s: %s", dir, path,
+                                 strerror(errno));
+        /* missing: the folder that would hold it must be writable */
+        char *slash = strrchr(path, '/');
+        if (!slash)
+            snprintf(path, sizeof path, ".");
+        else if (slash == path)
+            path[1] = '\0';
+        else
+            *slash = '\0';
+    }
 }
 
 sem_status sem_animation_create(const sem_animation_def *def, int n_objects,

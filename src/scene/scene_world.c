@@ -191,7 +191,7 @@ static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scen
 
 /* sem.resolution: object i's model cut into patches of at most L / resolution (L the
  * diagonal of its tessellation's box, which follows the trims), which the world simulates;
- * the patches keep the file's parts for the frames (sem_scene_world_frame_model). */
+ * the patches keep the file's parts for the frames (sem_scene_world_output_model). */
 static sem_status cut_patches(sem_scene_world *sw, int i, const sem_scene_world_options *o, sem_error *err)
 {
     const sem_scene_object *so = &sw->scene->objects[i];
@@ -542,13 +542,13 @@ const sem_model *sem_scene_world_model(const sem_scene_world *sw, int object)
     return sw && object >= 0 && object < sw->n ? sw->models[object] : NULL;
 }
 
-const sem_model *sem_scene_world_frame_model(const sem_scene_world *sw, int object)
+const sem_model *sem_scene_world_output_model(const sem_scene_world *sw, int object)
 {
     if (!sw || object < 0 || object >= sw->n) return NULL;
     return sw->patches[object].refined ? sw->patches[object].refined : sw->models[object];
 }
 
-void sem_scene_world_frame_q(const sem_scene_world *sw, int object, const double *q, double *q_frame)
+void sem_scene_world_output_q(const sem_scene_world *sw, int object, const double *q, double *q_frame)
 {
     if (sw->patches[object].refined)
         sem_patches_gather(&sw->patches[object], q, q_frame);
@@ -571,6 +571,35 @@ double sem_scene_world_file_unit_to_meter(const sem_scene_world *sw, int object)
     return sw && object >= 0 && object < sw->n && sw->file_unit_to_meter[object] > 0
                ? sw->file_unit_to_meter[object]
                : 1.0;
+}
+
+sem_status sem_scene_world_frame_model(const sem_scene_world *sw, int object, sem_model **out,
+                                       sem_error *err)
+{
+    if (!out) return sem_error_set(err, SEM_ERR_INVALID, "sem_scene_world_frame_model: no output");
+    *out = NULL;
+    if (!sw || object < 0 || object >= sw->n)
+        return sem_error_set(err, SEM_ERR_INVALID, "object %d of a scene world with %d objects", object,
+                             sw ? sw->n : 0);
+    const sem_model *shown = sem_scene_world_output_model(sw, object);
+    sem_model *m = sem_model_clone(shown);
+    size_t n = 3 * sem_model_control_points(shown);
+    double *x = malloc(n * sizeof *x + 1);
+    if (!m || !x) {
+        sem_model_destroy(m);
+        free(x);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    /* the animation writer's arithmetic (output/animation.c), so the numbers are the frame's */
+    const double to_file = 1.0 / sem_scene_world_file_unit_to_meter(sw, object);
+    sem_scene_world_output_q(sw, object, sem_world_object_q(sw->world, object), x);
+    for (size_t i = 0; i < n; ++i) x[i] *= to_file;
+    sem_model_set_q(m, x);
+    free(x);
+    snprintf(m->units, sizeof m->units, "%s", sem_scene_world_file_units(sw, object));
+    m->unit_to_meter = sem_scene_world_file_unit_to_meter(sw, object);
+    *out = m;
+    return SEM_OK;
 }
 
 int sem_scene_world_all_cached(const sem_scene_world *sw) { return sw ? sw->all_cached : 0; }
