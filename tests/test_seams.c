@@ -8,9 +8,9 @@
  *   points of the two faces no longer coincide).
  * - The checks of a world's state (sem_world_object_checks): at rest nothing is suspect;
  *   the control points scaled by s about the centre give volume_change = s^3 - 1 (an affine
- *   motion: det F = s^3 at every quadrature point) and the volume flag; one face moved out by
- *   5 % of the size gives the seam flag and an error energy that dominates (the polynomials
- *   no longer follow the surface).
+ *   motion: det F = s^3 at every quadrature point), reported, not suspect; mirrored, det F = -1
+ *   and the inverted flag; one face moved out by 5 % of the size gives the seam flag and an
+ *   error energy that dominates (the polynomials no longer follow the surface).
  * - Welds (sem_object_def.weld): the 10-section cantilever's faces, whose edges share control
  *   points, stay together under its static load, and its deflection hardly changes (88.76 %
  *   of FEM against 89.21 %).
@@ -166,9 +166,15 @@ static void test_world_checks(void)
     CHECK(sem_world_object_checks(t.world, 0, &c, &err) == SEM_OK, "%s", err.message);
     CHECK_REL(c.volume_change, 1.331 - 1, 1e-9);
     CHECK_REL(c.min_det_f, 1.331, 1e-9);
-    CHECK(c.suspect == SEM_SUSPECT_VOLUME, "scaled: suspect %d", c.suspect);
+    CHECK(c.suspect == 0, "scaled: suspect %d (a volume change alone is not)", c.suspect);
     CHECK(c.seam_gap_relative <= 0.1 * SEM_SEAM_TOLERANCE, "scaled: seams %g", c.seam_gap_relative);
     CHECK(c.error_share < 1e-12, "scaled: error share %g", c.error_share);
+    /* mirrored through z = 0 (x, y, -z): det F = -1 everywhere, turned inside out */
+    for (int i = 0; i < n; ++i) qs[i] = i % 3 == 2 ? -q[i] : q[i];
+    sem_world_object_set_state(t.world, 0, qs, NULL);
+    CHECK(sem_world_object_checks(t.world, 0, &c, &err) == SEM_OK, "%s", err.message);
+    CHECK_REL(c.min_det_f, -1.0, 1e-9);
+    CHECK(c.suspect & SEM_SUSPECT_INVERTED, "mirrored: suspect %d", c.suspect);
     /* face 5 (box_zmax) out by 5 % of the size */
     size_t off[7];
     sem_model_part_offsets(t.model, off);

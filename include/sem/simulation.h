@@ -227,7 +227,8 @@ typedef struct sem_object_checks {
     int seam_pairs;           /* point pairs watched (0: no part meets another) */
     double error_share;       /* error energy / (elastic + error energy) (Eq. 16 against
                                  Eq. 15); 0 while both are below SEM_CHECK_ENERGY_FLOOR E V */
-    double volume_change;     /* sum_p vol_p det F_p / rest volume - 1 */
+    double volume_change;     /* sum_p vol_p det F_p / rest volume - 1 (reported only: loads
+                                 and prescribed motion change a body's volume legitimately) */
     double min_det_f;         /* smallest det F over the quadrature points */
     int suspect;              /* SEM_SUSPECT_* flags of the limits below that are passed */
 } sem_object_checks;
@@ -236,11 +237,11 @@ typedef struct sem_object_checks {
  * corpus (docs/validation.md, "Seams and trust"). */
 #define SEM_SEAM_GAP_LIMIT 0.01      /* seam_gap_relative */
 #define SEM_ERROR_SHARE_LIMIT 0.5    /* error_share */
-#define SEM_VOLUME_CHANGE_LIMIT 0.05 /* |volume_change| */
 #define SEM_CHECK_ENERGY_FLOOR 1e-9  /* x E V: energies below are noise for error_share */
 #define SEM_SUSPECT_SEAM 1
 #define SEM_SUSPECT_ERROR_SHARE 2
-#define SEM_SUSPECT_VOLUME 4
+#define SEM_SUSPECT_INVERTED 4       /* min_det_f <= 0: an element turned inside out (a
+                                        material that allows it: linear, St. Venant-Kirchhoff) */
 
 /* The checks of object `object` now. The first call finds the object's seams (a pass over
  * its parts' boundaries, about the cost of a few steps); later calls cost about one
