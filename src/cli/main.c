@@ -112,7 +112,7 @@ static const cli_command commands[] = {
      "  --tolerance T   FEM refinement stops when the L2 norm and the largest surface displacement\n"
      "                  change by less than T between two meshes (0.005)\n"
      "  --max-levels N  at most N meshes (5), the characteristic length x 0.7 per mesh\n"
-     "  --max-nodes N   no mesh with more than N nodes (60000)\n"
+     "  --max-nodes N   no mesh with more than N nodes (40000)\n"
      "  --h0 H          first characteristic length, metres (the largest dimension / 10)\n"
      "  -E, --youngs-modulus E   Young's modulus, Pa, instead of the 1 % rule or the scene's\n"
      "  --workdir DIR   work in DIR (meshes, CalculiX files, sem's frames, surface_nodes.csv and\n"

@@ -153,6 +153,62 @@ def gmsh_tet10_to_abaqus(nodes, conn):
     return corners + [mid[frozenset((corners[i], corners[j]))] for i, j in TET10_EDGES]
 
 
+def _tet10_derivatives(r, s, t):
+    """d N_i / d(r, s, t) of the 10 Abaqus-ordered quadratic shape functions."""
+    L = (1 - r - s - t, r, s, t)
+    dL = ((-1, -1, -1), (1, 0, 0), (0, 1, 0), (0, 0, 1))
+    d = [tuple((4 * L[i] - 1) * dL[i][k] for k in range(3)) for i in range(4)]
+    for i, j in TET10_EDGES:
+        d.append(tuple(4 * (L[i] * dL[j][k] + L[j] * dL[i][k]) for k in range(3)))
+    return d
+
+
+# CalculiX's 4-point rule for C3D10 (where it checks the Jacobian) and the centroid
+_A, _B = 0.1381966011250105, 0.5854101966249685
+_TET10_CHECK = [_tet10_derivatives(*p) for p in ((_A, _A, _A), (_B, _A, _A), (_A, _B, _A), (_A, _A, _B),
+                                                 (0.25, 0.25, 0.25))]
+
+
+def tet10_min_jacobian_ratio(nodes, conn):
+    """The smallest Jacobian determinant of a C3D10 element at CalculiX's integration points
+    (and the centroid), relative to that of its straight-sided (corner) tetrahedron."""
+    X = [nodes[t] for t in conn]
+    v0 = dot(cross(sub(X[1], X[0]), sub(X[2], X[0])), sub(X[3], X[0]))
+    worst = math.inf
+    for d in _TET10_CHECK:
+        J = [[sum(d[n][k] * X[n][i] for n in range(10)) for k in range(3)] for i in range(3)]
+        det = (J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
+               + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]))
+        worst = min(worst, det / v0 if v0 > 0 else -math.inf)
+    return worst
+
+
+def straighten_tet10(nodes, elements, min_ratio=0.05, passes=5):
+    """Curved quadratic tetrahedra at a curved boundary can fold (gmsh places the mid-edge
+    nodes on the surface; a flat element there turns inside out), which CalculiX refuses.
+    Each element whose Jacobian ratio (tet10_min_jacobian_ratio) is below min_ratio gets its
+    mid-edge nodes moved to the midpoints of its corners (straight edges: a valid element).
+    Modifies nodes; returns (elements straightened, the set of moved nodes)."""
+    moved, fixed = set(), set()
+    todo = list(range(len(elements)))
+    for _ in range(passes):
+        bad = [e for e in todo if tet10_min_jacobian_ratio(nodes, elements[e]) < min_ratio]
+        if not bad:
+            break
+        touched = set()
+        for e in bad:
+            conn = elements[e]
+            fixed.add(e)
+            for k, (i, j) in enumerate(TET10_EDGES):
+                a, b = nodes[conn[i]], nodes[conn[j]]
+                nodes[conn[4 + k]] = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2)
+                moved.add(conn[4 + k])
+                touched.add(conn[4 + k])
+        # a moved node may change the neighbours that share it: check those again
+        todo = [e for e, conn in enumerate(elements) if any(t in touched for t in conn[4:])]
+    return len(fixed), moved
+
+
 def tet10_boundary_faces(elements):
     """The boundary of a mesh of Abaqus-ordered C3D10 elements: the 6-node triangles (3
     corners, then the mid nodes of edges 01, 12, 20) that belong to exactly one element,
@@ -201,11 +257,15 @@ def lame(E, nu):
     return mu, lam, K
 
 
+# CalculiX reads at most 20 characters of a number: "-1.234567890123e-05" is 19
+NUMBER = "%.13g"
+
+
 def write_nodes(f, nodes, ids=None):
     f.write("*NODE, NSET=NALL\n")
     for t in (sorted(nodes) if ids is None else ids):
         x, y, z = nodes[t]
-        f.write("%d, %.15g, %.15g, %.15g\n" % (t, x, y, z))
+        f.write(("%d, " + ", ".join([NUMBER] * 3) + "\n") % (t, x, y, z))
 
 
 def write_elements(f, elements, type_name):
@@ -230,11 +290,11 @@ def write_material(f, name, density, E, nu, model):
     """model: "neohookean" (*HYPERELASTIC, NEO HOOKE: C10 = mu / 2, D1 = 2 / K) or "elastic"
     (*ELASTIC: linear isotropic; under NLGEOM CalculiX makes it St. Venant-Kirchhoff)."""
     mu, lam, K = lame(E, nu)
-    f.write("*MATERIAL, NAME=%s\n*DENSITY\n%.12g\n" % (name, density))
+    f.write(("*MATERIAL, NAME=%s\n*DENSITY\n" + NUMBER + "\n") % (name, density))
     if model == "elastic":
-        f.write("*ELASTIC\n%.12g, %.12g\n" % (E, nu))
+        f.write(("*ELASTIC\n" + NUMBER + ", " + NUMBER + "\n") % (E, nu))
     else:
-        f.write("*HYPERELASTIC, NEO HOOKE\n%.12g, %.12g\n" % (mu / 2, 2 / K))
+        f.write(("*HYPERELASTIC, NEO HOOKE\n" + NUMBER + ", " + NUMBER + "\n") % (mu / 2, 2 / K))
 
 
 def read_dat_last_u(path):

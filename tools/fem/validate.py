@@ -60,6 +60,7 @@ ON_SURFACE = 1e-4        # a FEM surface node farther than this x L from sem's s
 UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "km": 1e3, "in": 0.0254, "ft": 0.3048,
          "mi": 1609.344, "mil": 2.54e-5, "uin": 2.54e-8}
 SOLVE_TIMEOUT = 3600.0   # seconds for one gmsh or CalculiX run
+SEW_TOLERANCES = (1e-7, 1e-5, 1e-4, 1e-3)  # gaps closed when sewing faces, x L
 
 
 class Fail(Exception):
@@ -102,7 +103,7 @@ def parse_args(argv):
     ap.add_argument("--keep", action="store_true")
     ap.add_argument("--no-install", action="store_true")
     ap.add_argument("--max-levels", type=int, default=5)
-    ap.add_argument("--max-nodes", type=int, default=60000)
+    ap.add_argument("--max-nodes", type=int, default=40000)
     ap.add_argument("--h0", type=float)
     ap.add_argument("-E", "--youngs-modulus", type=float, dest="youngs_modulus")
     ap.add_argument("--quiet", action="store_true")
@@ -285,17 +286,76 @@ def read_scene(path, problem):
 
 # ---------------------------------------------------------------- FEM side: gmsh
 
-def geo_header(model_path, scaling):
+def geo_header(model_path, scaling, sew, cuts):
+    """The model as Open CASCADE solids: the file's own solids (sew None), or its faces sewn
+    into shells with gaps up to `sew` metres closed, then made solids; cut along the planar
+    quadrilaterals `cuts` (4 corners each, gmsh coordinates) so that the mesh conforms to the
+    boundary of the pinned region."""
     quoted = model_path.replace("\\", "\\\\").replace('"', '\\"')
-    return ("SetFactory(\"OpenCASCADE\");\n"
-            "Geometry.OCCSewFaces = 1;\n"
-            "Geometry.OCCMakeSolids = 1;\n"
-            # Open CASCADE converts IGES and STEP lengths to millimetres; this scales them to
-            # metres (times the scene's unit override)
-            "Geometry.OCCScaling = %.17g;\n"
-            "Merge \"%s\";\n"
-            "v[] = Volume \"*\";\n"
-            "s[] = Surface \"*\";\n" % (scaling, quoted))
+    text = "SetFactory(\"OpenCASCADE\");\n"
+    if sew is not None:
+        # (sewing happens after the scaling below: the tolerance is in metres; "making solids"
+        # of a STEP file's own solids can break them, so only sewn faces get it)
+        text += "Geometry.Tolerance = %.17g;\nGeometry.OCCSewFaces = 1;\nGeometry.OCCMakeSolids = 1;\n" % sew
+    text += (# Open CASCADE converts IGES and STEP lengths to millimetres; this scales them to
+             # metres (times the scene's unit override)
+             "Geometry.OCCScaling = %.17g;\n"
+             "Merge \"%s\";\n"
+             "v[] = Volume \"*\";\n"
+             "s[] = Surface \"*\";\n" % (scaling, quoted))
+    if cuts:
+        text += "cut[] = {};\n"
+        for quad in cuts:
+            text += "p0 = newp;\n"
+            for k, x in enumerate(quad):
+                text += "Point(p0 + %d) = {%.17g, %.17g, %.17g};\n" % ((k,) + tuple(x))
+            text += "l0 = newl;\n"
+            for k in range(4):
+                text += "Line(l0 + %d) = {p0 + %d, p0 + %d};\n" % (k, k, (k + 1) % 4)
+            text += ("c0 = newll;\nCurve Loop(c0) = {l0, l0 + 1, l0 + 2, l0 + 3};\n"
+                     "q0 = news;\nPlane Surface(q0) = {c0};\ncut[] += q0;\n")
+        text += ("If (#v[] > 0)\n"
+                 "  BooleanFragments{ Volume{v[]}; Delete; }{ Surface{cut[]}; Delete; }\n"
+                 "  v[] = Volume \"*\";\n"
+                 "EndIf\n")
+    return text
+
+
+def inverse3(A):
+    a, b, c = A[0]
+    d, e, f = A[1]
+    g, h, i = A[2]
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    return [[(e * i - f * h) / det, (c * h - b * i) / det, (b * f - c * e) / det],
+            [(f * g - d * i) / det, (a * i - c * g) / det, (c * d - a * f) / det],
+            [(d * h - e * g) / det, (b * g - a * h) / det, (a * e - b * d) / det]]
+
+
+def pin_cuts(problem, wbox, L):
+    """The faces of the pin box that pass through the model (world box wbox), clipped to it,
+    as quadrilaterals in gmsh's coordinates (the file's geometry in metres, before the
+    transform)."""
+    Ainv = inverse3(problem.A)
+    to_file = lambda x: tuple(sum(Ainv[r][k] * (x[k] - problem.b[k]) for k in range(3)) for r in range(3))
+    margin = 0.01 * L
+    cuts = []
+    for axis in range(3):
+        for side in (0, 1):
+            c = problem.pin_box[side][axis]
+            if not wbox[0][axis] + 1e-6 * L < c < wbox[1][axis] - 1e-6 * L:
+                continue
+            o = [k for k in range(3) if k != axis]
+            lo = [max(problem.pin_box[0][k], wbox[0][k] - margin) for k in o]
+            hi = [min(problem.pin_box[1][k], wbox[1][k] + margin) for k in o]
+            if not (lo[0] < hi[0] and lo[1] < hi[1]):
+                continue
+            quad = []
+            for u, v in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])):
+                x = [0.0, 0.0, 0.0]
+                x[axis], x[o[0]], x[o[1]] = c, u, v
+                quad.append(to_file(x))
+            cuts.append(quad)
+    return cuts
 
 
 def run_gmsh(args, workdir, what):
@@ -309,18 +369,19 @@ def run_gmsh(args, workdir, what):
     return r, errors
 
 
-def gmsh_solids(workdir, model_path, scaling):
-    """Volumes and surfaces Open CASCADE makes of the file, and the volumes' box (metres)."""
+def gmsh_solids(workdir, model_path, scaling, sew, cuts):
+    """Volumes and surfaces Open CASCADE makes of the file (cut by `cuts`), the faces that
+    bound a volume, the volumes' box and gmsh's error lines."""
     geo = os.path.join(workdir, "solids.geo")
     with open(geo, "w") as f:
-        f.write(geo_header(model_path, scaling))
+        f.write(geo_header(model_path, scaling, sew, cuts))
         f.write("b[] = Unique(Abs(Boundary{ Volume{v[]}; }));\n"
                 "Printf(\"SEMVALIDATE %g %g %g\", #v[], #s[], #b[]);\n"
                 "If (#v[] > 0)\n"
                 "  bb[] = BoundingBox Volume{v[]};\n"
                 "  Printf(\"SEMVALIDATE_BOX %.17g %.17g %.17g %.17g %.17g %.17g\", bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);\n"
                 "EndIf\n")
-    r, errors = run_gmsh(["-0", geo, "-o", os.path.join(workdir, "solids.geo_unrolled")], workdir, "reading the model")
+    r, errors = run_gmsh([geo, "-parse_and_exit"], workdir, "reading the model")
     counts = box = None
     for line in r.stdout.splitlines():
         t = line.split()
@@ -333,12 +394,12 @@ def gmsh_solids(workdir, model_path, scaling):
     return counts[0], counts[1], counts[2], box, errors
 
 
-def gmsh_mesh(workdir, job, model_path, scaling, h):
+def gmsh_mesh(workdir, job, model_path, scaling, sew, cuts, h):
     """Quadratic tetrahedra of characteristic length h: (nodes {tag: x}, [Abaqus C3D10 node lists])."""
     geo = os.path.join(workdir, job + ".geo")
     msh = os.path.join(workdir, job + ".msh")
     with open(geo, "w") as f:
-        f.write(geo_header(model_path, scaling))
+        f.write(geo_header(model_path, scaling, sew, cuts))
         f.write("Physical Volume(1) = {v[]};\n"
                 "Mesh.CharacteristicLengthMax = %.17g;\n"
                 "Mesh.ElementOrder = 2;\n"
@@ -355,20 +416,26 @@ def gmsh_mesh(workdir, job, model_path, scaling, h):
     elements = [fem_common.gmsh_tet10_to_abaqus(nodes, conn) for _, conn in raw]
     used = set(t for conn in elements for t in conn)
     nodes = {t: nodes[t] for t in used}
-    return nodes, elements, seconds, errors
+    straightened, _ = fem_common.straighten_tet10(nodes, elements)
+    return nodes, elements, seconds, straightened
 
 
 # ---------------------------------------------------------------- FEM side: CalculiX
 
-def write_inp(path, nodes, elements, pinned, surface, problem, E, material):
+def write_inp(path, nodes, elements, pinned, surface, problem, E, material, ell):
+    """The CalculiX input in a length unit of ell metres (mass kg, time s): CalculiX checks
+    its Jacobian determinants against an absolute threshold, which a centimetre-sized model's
+    elements in metres fall below. So x' = x / ell, E' = E ell, rho' = rho ell^3, g' = g / ell,
+    and displacements come back in units of ell."""
     g = math.sqrt(sum(c * c for c in problem.gravity))
+    scaled = {t: tuple(c / ell for c in x) for t, x in nodes.items()}
     with open(path, "w") as f:
-        f.write("*HEADING\nsem validate\n")
-        fem_common.write_nodes(f, nodes)
+        f.write("*HEADING\nsem validate (lengths in units of %g m)\n" % ell)
+        fem_common.write_nodes(f, scaled)
         fem_common.write_elements(f, elements, "C3D10")
         fem_common.write_nset(f, "NPIN", pinned)
         fem_common.write_nset(f, "NSURF", surface)
-        fem_common.write_material(f, "M", problem.density, E, problem.nu,
+        fem_common.write_material(f, "M", problem.density * ell ** 3, E * ell, problem.nu,
                                   "elastic" if material in ("linear", "stvk") else "neohookean")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=M\n*BOUNDARY\nNPIN, 1, 3\n")
         if material == "linear":
@@ -377,8 +444,8 @@ def write_inp(path, nodes, elements, pinned, surface, problem, E, material):
             # NLGEOM; the whole load in one increment, cut back automatically when it does not
             # converge
             f.write("*STEP, NLGEOM, INC=1000\n*STATIC\n1.0, 1.0, 1e-6, 1.0\n")
-        f.write("*DLOAD\nEALL, GRAV, %.17g, %.17g, %.17g, %.17g\n" % (
-            g, problem.gravity[0] / g, problem.gravity[1] / g, problem.gravity[2] / g))
+        f.write(("*DLOAD\nEALL, GRAV, " + ", ".join([fem_common.NUMBER] * 4) + "\n") % (
+            g / ell, problem.gravity[0] / g, problem.gravity[1] / g, problem.gravity[2] / g))
         f.write("*NODE PRINT, NSET=NSURF\nU\n*END STEP\n")
 
 
@@ -418,14 +485,17 @@ def fem_solve(workdir, job, mesh, problem, E, material, eps):
     pinned = mesh.pinned(problem.pin_box, eps)
     if not pinned:
         raise Fail("no FEM node lies in the pin box %s" % json.dumps(problem.pin_box))
+    # a power of ten near the model's size: coordinates of order 1 to 10 in CalculiX
+    size = max(mesh.box[1][c] - mesh.box[0][c] for c in range(3))
+    ell = 10.0 ** math.floor(math.log10(size))
     write_inp(os.path.join(workdir, job + ".inp"), mesh.nodes, mesh.elements, pinned, mesh.surface, problem, E,
-              material)
+              material, ell)
     threads = max(1, min(8, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 2))
     try:
         seconds = fem_common.run_ccx(workdir, job, threads=threads, timeout=SOLVE_TIMEOUT)
     except ToolFailed as e:
         raise Fail("%s%s" % (e, " (is every solid held by the pins?)" if "singular" in str(e).lower() else ""))
-    u = fem_common.read_dat_last_u(os.path.join(workdir, job + ".dat"))
+    u = {t: tuple(c * ell for c in v) for t, v in fem_common.read_dat_last_u(os.path.join(workdir, job + ".dat")).items()}
     missing = [t for t in mesh.surface if t not in u]
     if missing:
         raise Fail("CalculiX printed no displacement for %d surface nodes (%s.dat)" % (len(missing), job))
@@ -526,16 +596,6 @@ def validate(args, workdir):
     tools = {"gmsh": fem_common.tool_version(["gmsh", "--version"]),
              "ccx": fem_common.tool_version(["ccx", "-v"])}
 
-    # Open CASCADE reads the file in millimetres of the file's own unit
-    scaling = 1e-3 * problem.units_factor / file_u2m
-    n_vol, n_surf, n_bound, occ_box, gmsh_errors = gmsh_solids(workdir, model, scaling)
-    if n_vol == 0:
-        raise Fail("%s: gmsh could not make a solid of its faces (open surfaces or gaps): %d faces, no closed shell%s"
-                   % (args.model, n_surf, "; " + gmsh_errors[0] if gmsh_errors else ""))
-    log("gmsh: %d solid%s of %d faces%s" % (n_vol, "" if n_vol == 1 else "s", n_surf,
-                                           "" if n_bound >= n_surf else " (%d faces bound no solid)" % (n_surf - n_bound)))
-
-    h0 = args.h0 if args.h0 else size_file_m / 10
     # the world box and size (after the transform), from sem's box of the surfaces
     corners = [apply(problem.A, problem.b, (bbox_file_m[i][0], bbox_file_m[j][1], bbox_file_m[k][2]))
                for i in (0, 1) for j in (0, 1) for k in (0, 1)]
@@ -552,10 +612,58 @@ def validate(args, workdir):
     if not g > 0:
         raise Fail("gravity is zero: nothing to compare")
 
+    # Open CASCADE reads the file in millimetres of the file's own unit
+    scaling = 1e-3 * problem.units_factor / file_u2m
+    # the file's own solids (STEP files have them; sewing would take them apart), else its
+    # faces sewn with growing tolerances (gaps of CAD exports)
+    for sew in [None] + [f * size_file_m for f in SEW_TOLERANCES]:
+        n_vol, n_surf, n_bound, _, gmsh_errors = gmsh_solids(workdir, model, scaling, sew, [])
+        if n_vol > 0:
+            break
+    if n_vol == 0:
+        raise Fail("%s: gmsh could not make a solid of its faces (open surfaces or gaps): %d faces, no closed shell "
+                   "(sewn with gaps up to %g m)%s" % (args.model, n_surf, sew, "; " + gmsh_errors[0] if gmsh_errors else ""))
+    log("gmsh: %d solid%s of %d faces%s%s" % (
+        n_vol, "" if n_vol == 1 else "s", n_surf, "" if sew is None else ", sewn with gaps up to %s" % fmt_len(sew),
+        "" if n_bound >= n_surf else " (%d faces bound no solid)" % (n_surf - n_bound)))
+    # the mesh follows the boundary of the pinned region (else the pinned nodes, and so the
+    # answer, would jump with the mesh); where Open CASCADE cannot cut, it does not
+    cuts = pin_cuts(problem, wbox, L)
+    if cuts:
+        n_cut, _, _, _, cut_errors = gmsh_solids(workdir, model, scaling, sew, cuts)
+        if n_cut <= n_vol or cut_errors:
+            log("gmsh could not cut the solids along the pin box (%s): the pinned nodes follow the mesh" % (
+                cut_errors[0] if cut_errors else "%d solids after the cut" % n_cut))
+            cuts = []
+    h0 = args.h0 if args.h0 else size_file_m / 10
+
     # FEM level 0, and E by the 1 % rule when neither the scene nor -E gives it
     t_fem = time.time()
     h = h0
-    nodes, elements, mesh_s, _ = gmsh_mesh(workdir, "level0", model, scaling, h)
+    # gmsh fails on some shapes at coarse sizes (a boundary mesh that intersects itself) or
+    # along the cut: the first mesh takes the first that works of h0, 0.7 h0, 0.49 h0, each
+    # with the cut and then without
+    first_error = None
+    for attempt in range(3):
+        for with_cuts in ([True, False] if cuts else [False]):
+            try:
+                nodes, elements, mesh_s, straightened = gmsh_mesh(workdir, "level0", model, scaling, sew,
+                                                                   cuts if with_cuts else [], h)
+                break
+            except Fail as e:
+                first_error = first_error or e
+                log(str(e))
+        else:
+            h *= REFINE_FACTOR
+            continue
+        if not with_cuts and cuts:
+            log("meshed without the cut along the pin box: the pinned nodes follow the mesh")
+            cuts = []
+        break
+    else:
+        # Open CASCADE also makes "solids" of open shells, which then do not mesh
+        raise Fail("%s: gmsh made a solid of its faces but could not mesh it (open surfaces or gaps, or a shape its "
+                   "mesher does not take): %s" % (args.model, first_error))
     if len(nodes) > args.max_nodes:
         raise Fail("the coarsest mesh (h %g m) has %d nodes, more than --max-nodes %d: give a larger --h0 or "
                    "--max-nodes" % (h, len(nodes), args.max_nodes))
@@ -610,18 +718,31 @@ def validate(args, workdir):
     while True:
         k = len(levels)
         if k > 0:
-            nodes, elements, mesh_s, _ = gmsh_mesh(workdir, "level%d" % k, model, scaling, h)
+            try:
+                nodes, elements, mesh_s, straightened = gmsh_mesh(workdir, "level%d" % k, model, scaling, sew,
+                                                                  cuts, h)
+            except Fail as e:
+                stopped = str(e)
+                break
             if len(nodes) > args.max_nodes:
                 stopped = "the next mesh (h %g m) has %d nodes, more than --max-nodes %d" % (h, len(nodes), args.max_nodes)
                 break
             mesh = Mesh(nodes, elements, problem)
-        u, n_pinned, ccx_s = fem_solve(workdir, "level%d" % k, mesh, problem, problem.E, problem.material, eps)
+        try:
+            u_k, n_pinned, ccx_s = fem_solve(workdir, "level%d" % k, mesh, problem, problem.E, problem.material, eps)
+        except Fail as e:
+            if k == 0:
+                raise
+            stopped = str(e)
+            break
+        u, solved_mesh = u_k, mesh
         l2, umax = surface_norms(mesh.faces, u)
         prev = levels[-1] if levels else None
         ch_l2 = None if prev is None else abs(l2 / prev["l2_norm"] - 1)
         ch_max = None if prev is None else abs(umax / prev["max_displacement_m"] - 1)
         levels.append({"h": h, "nodes": len(mesh.nodes), "elements": len(mesh.elements), "dofs": 3 * len(mesh.nodes),
-                       "surface_nodes": len(mesh.surface), "pinned_nodes": n_pinned, "l2_norm": l2,
+                       "surface_nodes": len(mesh.surface), "straightened_elements": straightened,
+                       "pinned_nodes": n_pinned, "l2_norm": l2,
                        "max_displacement_m": umax, "change_l2": ch_l2, "change_max": ch_max,
                        "mesh_s": round(mesh_s, 2), "ccx_s": round(ccx_s, 2)})
         log("FEM level %d: h %s, %d nodes: L2 %.6g, max %s%s (CalculiX %.1f s)" % (
@@ -642,7 +763,7 @@ def validate(args, workdir):
     if not converged:
         print("sem: warning: validate: the FEM solution did not converge to --tolerance %g: %s" % (
             args.tolerance, stopped), file=sys.stderr)
-    fem_mesh, fem_u = mesh, u   # the finest level solved
+    fem_mesh, fem_u = solved_mesh, u   # the finest level solved
 
     # sem at the FEM surface nodes
     tol_on = ON_SURFACE * L
@@ -695,11 +816,13 @@ def validate(args, workdir):
                          "poisson_ratio": problem.nu, "youngs_modulus_rule": problem.E_rule,
                          "calculix": "*ELASTIC" if problem.material in ("linear", "stvk") else "*HYPERELASTIC, NEO HOOKE",
                          "nlgeom": problem.material != "linear"},
-            "pin": {"box": problem.pin_box, "rule": problem.pin_rule},
+            "pin": {"box": problem.pin_box, "rule": problem.pin_rule,
+                    "mesh_cut_along_box": bool(cuts)},
         },
         "fem": {
             "tools": tools,
             "solids": n_vol,
+            "sewing_tolerance_m": sew,
             "faces": n_surf,
             "faces_without_solid": max(0, n_surf - n_bound),
             "element": "C3D10",
