@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sem needs when they are missing (run as root, or with sudo).
 # With --test also what the test suite needs: node and npm (the glTF validator, installed
-# from the npm registry into tests/js/node_modules) and Chromium with its WebDriver (the
-# browser test of sem view).
+# from the npm registry into tests/js/node_modules), Chromium with its WebDriver (the
+# browser test of sem view), gmsh and CalculiX (sem validate's FEM side).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 #   bash scripts/setup.sh                 what building and running sem needs
@@ -38,6 +38,9 @@ if [ $with_tests = 1 ]; then
   command -v npm >/dev/null 2>&1 || missing+=(npm)
   command -v chromium >/dev/null 2>&1 || missing+=(chromium)
   command -v chromedriver >/dev/null 2>&1 || missing+=(chromium-driver)
+  # sem validate's FEM side (tests/test_validate.c; skipped when they cannot be installed)
+  command -v gmsh >/dev/null 2>&1 || missing+=(gmsh)
+  command -v ccx >/dev/null 2>&1 || missing+=(calculix-ccx)
 fi
 if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]}" >&2
