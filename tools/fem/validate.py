@@ -18,11 +18,15 @@ The problem, the same on both sides:
   * pinned: the points whose rest z lies in the lowest 10 % of the model's height (FEM: every
     node there; sem: every control point there, through a pin box), or the scene's pin box.
 
-FEM side: gmsh (Open CASCADE kernel: the faces sewn into shells and solids) meshes the file
-into 10-node tetrahedra; CalculiX solves the static problem with geometric nonlinearity
-(*STATIC in a *STEP, NLGEOM). The mesh is refined (characteristic length x 0.7) until the
+FEM side: gmsh (Open CASCADE kernel) takes the file's own solids, or sews its faces into
+shells (gaps up to 1e-7 .. 1e-3 L, the first that closes) and makes solids of them; cuts them
+along the faces of the pin box that pass through the model (so the pinned region does not
+change with the mesh); meshes them into 10-node tetrahedra (curved at the boundary; an element
+that folds there is straightened). CalculiX solves the static problem with geometric
+nonlinearity (*STATIC in a *STEP, NLGEOM; the material model of sem's, see write_inp). The
+mesh is refined from h0 = L / 10 (characteristic length x 0.7 per level) until the
 area-weighted L2 norm of the surface displacement and the largest surface displacement both
-change by less than --tolerance between two meshes.
+change by less than --tolerance between two meshes, within --max-levels and --max-nodes.
 
 sem side: `sem run` on a scene of one object with integrator "static" and one frame, at sem's
 defaults (or the scene's `sem` settings). Every frame is the rest model with moved control
@@ -370,28 +374,22 @@ def run_gmsh(args, workdir, what):
 
 
 def gmsh_solids(workdir, model_path, scaling, sew, cuts):
-    """Volumes and surfaces Open CASCADE makes of the file (cut by `cuts`), the faces that
-    bound a volume, the volumes' box and gmsh's error lines."""
+    """Volumes and faces Open CASCADE makes of the file (cut by `cuts`), the faces that
+    bound a volume, and gmsh's error lines."""
     geo = os.path.join(workdir, "solids.geo")
     with open(geo, "w") as f:
         f.write(geo_header(model_path, scaling, sew, cuts))
         f.write("b[] = Unique(Abs(Boundary{ Volume{v[]}; }));\n"
-                "Printf(\"SEMVALIDATE %g %g %g\", #v[], #s[], #b[]);\n"
-                "If (#v[] > 0)\n"
-                "  bb[] = BoundingBox Volume{v[]};\n"
-                "  Printf(\"SEMVALIDATE_BOX %.17g %.17g %.17g %.17g %.17g %.17g\", bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);\n"
-                "EndIf\n")
+                "Printf(\"SEMVALIDATE %g %g %g\", #v[], #s[], #b[]);\n")
     r, errors = run_gmsh([geo, "-parse_and_exit"], workdir, "reading the model")
-    counts = box = None
+    counts = None
     for line in r.stdout.splitlines():
         t = line.split()
         if t[:1] == ["SEMVALIDATE"] and len(t) == 4:
             counts = [int(float(v)) for v in t[1:]]
-        elif t[:1] == ["SEMVALIDATE_BOX"] and len(t) == 7:
-            box = [float(v) for v in t[1:]]
     if counts is None:
         raise Fail("gmsh could not read it: %s" % (errors[0] if errors else "no output"))
-    return counts[0], counts[1], counts[2], box, errors
+    return counts[0], counts[1], counts[2], errors
 
 
 def gmsh_mesh(workdir, job, model_path, scaling, sew, cuts, h):
@@ -475,6 +473,11 @@ class Mesh:
         lo = [min(self.nodes[t][c] for t in self.surface) for c in range(3)]
         hi = [max(self.nodes[t][c] for t in self.surface) for c in range(3)]
         self.box = [lo, hi]
+        # of the straight-sided (corner) tetrahedra: a check of what the FEM fills, not an integral
+        self.volume = sum(abs(fem_common.dot(fem_common.cross(fem_common.sub(self.nodes[c[1]], self.nodes[c[0]]),
+                                                              fem_common.sub(self.nodes[c[2]], self.nodes[c[0]])),
+                                             fem_common.sub(self.nodes[c[3]], self.nodes[c[0]]))) / 6
+                          for c in elements)
 
     def pinned(self, box, eps):
         return [t for t in sorted(self.nodes) if all(box[0][c] - eps <= self.nodes[t][c] <= box[1][c] + eps
@@ -548,8 +551,9 @@ def text_report(r):
             k, fmt_len(l["h"]), l["nodes"], l["l2_norm"], l["max_displacement_m"],
             "" if l["change_l2"] is None else "  change %.2f %% / %.2f %%" % (100 * l["change_l2"], 100 * l["change_max"]),
             l["mesh_s"], l["ccx_s"]))
-    lines.append("sem       %d dofs, %d parts; %.1f s (preprocessing %.2f s, static solve %.2f s)" % (
-        semr["dofs"], r["parts"], semr["seconds"], semr["preprocess_s"], semr["solve_s"]))
+    lines.append("sem       %d dofs, %d parts; %.1f s (preprocessing %.2f s, static solve %.2f s); volume %.4g m^3, "
+                 "%.3f x the FEM mesh's" % (semr["dofs"], r["parts"], semr["seconds"], semr["preprocess_s"],
+                                           semr["solve_s"], semr["volume_m3"], cmp_["volume_ratio"]))
     for w in semr["warnings"]:
         lines.append("          " + w)
     lines.append("surface   %d FEM surface nodes: %d on sem's surfaces (farthest %.3g m), %d off them (> %.3g m), "
@@ -617,9 +621,12 @@ def validate(args, workdir):
     # the file's own solids (STEP files have them; sewing would take them apart), else its
     # faces sewn with growing tolerances (gaps of CAD exports)
     for sew in [None] + [f * size_file_m for f in SEW_TOLERANCES]:
-        n_vol, n_surf, n_bound, _, gmsh_errors = gmsh_solids(workdir, model, scaling, sew, [])
+        n_vol, n_surf, n_bound, gmsh_errors = gmsh_solids(workdir, model, scaling, sew, [])
         if n_vol > 0:
             break
+    if n_surf == 0:
+        raise Fail("%s: gmsh (Open CASCADE) could not read any face of it%s" % (
+            args.model, ": " + gmsh_errors[0] if gmsh_errors else ""))
     if n_vol == 0:
         raise Fail("%s: gmsh could not make a solid of its faces (open surfaces or gaps): %d faces, no closed shell "
                    "(sewn with gaps up to %g m)%s" % (args.model, n_surf, sew, "; " + gmsh_errors[0] if gmsh_errors else ""))
@@ -630,7 +637,7 @@ def validate(args, workdir):
     # answer, would jump with the mesh); where Open CASCADE cannot cut, it does not
     cuts = pin_cuts(problem, wbox, L)
     if cuts:
-        n_cut, _, _, _, cut_errors = gmsh_solids(workdir, model, scaling, sew, cuts)
+        n_cut, _, _, cut_errors = gmsh_solids(workdir, model, scaling, sew, cuts)
         if n_cut <= n_vol or cut_errors:
             log("gmsh could not cut the solids along the pin box (%s): the pinned nodes follow the mesh" % (
                 cut_errors[0] if cut_errors else "%d solids after the cut" % n_cut))
@@ -678,7 +685,10 @@ def validate(args, workdir):
         problem.E_rule = "--youngs-modulus"
     elif problem.E is None:
         E0 = 100 * problem.density * g * L
-        u0, _, _ = fem_solve(workdir, "estimate_E", mesh, problem, E0, "linear", eps)
+        try:
+            u0, _, _ = fem_solve(workdir, "estimate_E", mesh, problem, E0, "linear", eps)
+        except Fail as e:
+            raise Fail("%s: %s" % (args.model, e))
         d0 = max(fem_common.norm(u0[t]) for t in mesh.surface)
         if not d0 > 0:
             raise Fail("the linear FEM solve with E %g Pa moves nothing" % E0)
@@ -732,7 +742,7 @@ def validate(args, workdir):
             u_k, n_pinned, ccx_s = fem_solve(workdir, "level%d" % k, mesh, problem, problem.E, problem.material, eps)
         except Fail as e:
             if k == 0:
-                raise
+                raise Fail("%s: %s" % (args.model, e))
             stopped = str(e)
             break
         u, solved_mesh = u_k, mesh
@@ -742,6 +752,7 @@ def validate(args, workdir):
         ch_max = None if prev is None else abs(umax / prev["max_displacement_m"] - 1)
         levels.append({"h": h, "nodes": len(mesh.nodes), "elements": len(mesh.elements), "dofs": 3 * len(mesh.nodes),
                        "surface_nodes": len(mesh.surface), "straightened_elements": straightened,
+                       "volume_m3": mesh.volume,
                        "pinned_nodes": n_pinned, "l2_norm": l2,
                        "max_displacement_m": umax, "change_l2": ch_l2, "change_max": ch_max,
                        "mesh_s": round(mesh_s, 2), "ccx_s": round(ccx_s, 2)})
@@ -854,6 +865,7 @@ def validate(args, workdir):
             "max_distance_on_m": max_on,
             "max_distance_off_m": max((info_node[t][1] for t in off), default=None),
             "nodes_outside_trims": sum(1 for t in used if not info_node[t][2]),
+            "volume_ratio": (summary.get("volume") or 0) / fem_mesh.volume,
             "faces_used": len(faces_used),
             "faces": len(fem_mesh.faces),
             "l2_norm_fem": l2_fem,
