@@ -523,6 +523,26 @@ def probe(sem, workdir, rest, frame, points_world, to_frame, slack_frame):
     return rows
 
 
+class AtomicFile:
+    """A text file written to NAME.tmp.PID and renamed into place when complete, so a reader
+    (or an interrupted run) never leaves half a file under the name."""
+
+    def __init__(self, path):
+        self.path, self.tmp = path, "%s.tmp.%d" % (path, os.getpid())
+
+    def __enter__(self):
+        self.f = open(self.tmp, "w")
+        return self.f
+
+    def __exit__(self, kind, value, tb):
+        self.f.close()
+        if kind is None:
+            os.replace(self.tmp, self.path)
+        else:
+            os.unlink(self.tmp)
+        return False
+
+
 def fmt_len(x):
     return "%.4g m" % x
 
@@ -800,14 +820,14 @@ def validate(args, workdir):
     off = [t for t in ids if t not in used]
 
     # per-node data for other tools (and the tests)
-    with open(os.path.join(workdir, "surface_nodes.csv"), "w") as f:
+    with AtomicFile(os.path.join(workdir, "surface_nodes.csv")) as f:
         f.write("node,x,y,z,ux_fem,uy_fem,uz_fem,ux_sem,uy_sem,uz_sem,distance,part,inside_trim,used\n")
         for t in ids:
             part, dist, inside = info_node[t]
             f.write("%d,%s,%s,%d,%d,%d\n" % (
                 t, ",".join("%.17g" % c for c in fem_mesh.nodes[t] + fem_u[t] + u_sem[t]), "%.6g" % dist, part,
                 inside, t in used))
-    with open(os.path.join(workdir, "surface_faces.csv"), "w") as f:
+    with AtomicFile(os.path.join(workdir, "surface_faces.csv")) as f:
         f.write("n1,n2,n3,n12,n23,n31\n")
         for face, _ in fem_mesh.faces:
             f.write(",".join(str(t) for t in face) + "\n")
