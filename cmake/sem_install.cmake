@@ -12,6 +12,7 @@
 #   P/lib/pkgconfig/sem.pc                 pkg-config (--static adds the private libraries)
 #   P/lib/cmake/sem/semConfig.cmake ...    find_package(sem): sem::sem (shared), sem::sem_static
 #   P/share/man/man1/sem.1                 the manual page
+#   P/share/sem/fem/validate.py, fem_common.py   what `sem validate` runs (python3)
 #   P/lib/python3.N/dist-packages/sem/     the Python package (cmake/sem_python.cmake)
 #   P/share/sem/sem_blender.zip            the Blender add-on (cmake/sem_blender.cmake)
 # (lib is CMAKE_INSTALL_LIBDIR.) Third-party libraries are linked privately: a program
@@ -100,6 +101,10 @@ install(TARGETS sem_shared semlib EXPORT semTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 if(TARGET sem)
   install(TARGETS sem RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # sem validate: the FEM comparison it runs with python3 (cmd_validate.c finds it at
+  # <bindir>/../share/sem/fem)
+  install(PROGRAMS ${CMAKE_SOURCE_DIR}/tools/fem/validate.py DESTINATION ${CMAKE_INSTALL_DATADIR}/sem/fem)
+  install(FILES ${CMAKE_SOURCE_DIR}/tools/fem/fem_common.py DESTINATION ${CMAKE_INSTALL_DATADIR}/sem/fem)
 endif()
 install(FILES ${SEM_PUBLIC_HEADERS} ${CMAKE_BINARY_DIR}/include/sem/version.h
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/sem)

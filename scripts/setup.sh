@@ -2,7 +2,8 @@
 # Installs the Debian packages sem needs when they are missing (run as root, or with sudo).
 # With --test also what the test suite needs: node and npm (the glTF validator, installed
 # from the npm registry into tests/js/node_modules), Chromium with its WebDriver (the
-# browser test of sem view) and Blender (Debian's, 3.4 on bookworm: the add-on's test).
+# browser test of sem view), Blender (Debian's, 3.4 on bookworm: the add-on's test), gmsh and
+# CalculiX (sem validate's FEM side).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 #   bash scripts/setup.sh                 what building and running sem needs
@@ -39,6 +40,9 @@ if [ $with_tests = 1 ]; then
   command -v chromium >/dev/null 2>&1 || missing+=(chromium)
   command -v chromedriver >/dev/null 2>&1 || missing+=(chromium-driver)
   command -v blender >/dev/null 2>&1 || missing+=(blender)
+  # sem validate's FEM side (tests/test_validate.c; skipped when they cannot be installed)
+  command -v gmsh >/dev/null 2>&1 || missing+=(gmsh)
+  command -v ccx >/dev/null 2>&1 || missing+=(calculix-ccx)
 fi
 if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]}" >&2

@@ -34,6 +34,8 @@ int cmd_run(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_view(int argc, char **argv);
+int cmd_validate(int argc, char **argv);
+int cmd_probe(int argc, char **argv); /* hidden: validate's helper */
 
 /* ---- messages (main.c) ---- */
 /* Prints "sem: <message>" on stderr; returns CLI_FAILED. */

@@ -97,7 +97,45 @@ static const cli_command commands[] = {
      "  -o FILE   write the page there instead of OUT_DIR/viewer.html\n"
      "  The page bundles three.js from the Debian package libjs-three\n"
      "  (/usr/share/javascript/three; SEM_THREE_DIR overrides the folder).\n"},
+    {"validate", cmd_validate,
+     "MODEL [SCENE] [--json] [--tolerance T] [--workdir DIR] [--keep] [--no-install] [--max-levels N] [--max-nodes N] [--h0 H] [-E E] [--quiet]",
+     "sem against a converged FEM solution (gmsh + CalculiX) of the same static sag",
+     "  Meshes MODEL with gmsh (Open CASCADE, faces sewn into solids) into quadratic tetrahedra,\n"
+     "  solves the static sag under gravity with CalculiX (neo-Hookean, NLGEOM), refining the mesh\n"
+     "  until the answer changes by less than T, runs the same problem through sem (integrator\n"
+     "  static) and compares the two at the FEM surface nodes: relative L2 error of the displacement\n"
+     "  (area-weighted) and the largest displacement of each. Needs python3; gmsh and calculix-ccx\n"
+     "  come from Debian and are installed with apt-get when missing (docs/validation.md).\n"
+     "  Problem without SCENE: the model in metres (its file's units), gravity 9.81 m/s^2 along -z,\n"
+     "  neo-Hookean density 1000 kg/m^3, nu 0.45, E chosen so that the largest displacement is\n"
+     "  about 1 % of the model's largest dimension, pinned where z is in the lowest 10 % of the\n"
+     "  height. SCENE (one object; its model is replaced by MODEL): its units, transform, material,\n"
+     "  gravity, pin box and sem settings instead.\n"
+     "  --json          print one JSON object (the report) on stdout\n"
+     "  --tolerance T   FEM refinement stops when the L2 norm and the largest surface displacement\n"
+     "                  change by less than T between two meshes (0.005)\n"
+     "  --max-levels N  at most N meshes (5), the characteristic length x 0.7 per mesh\n"
+     "  --max-nodes N   no mesh with more than N nodes (40000)\n"
+     "  --h0 H          first characteristic length, metres (the largest dimension / 10)\n"
+     "  -E, --youngs-modulus E   Young's modulus, Pa, instead of the 1 % rule or the scene's\n"
+     "  --workdir DIR   work in DIR (meshes, CalculiX files, sem's frames, surface_nodes.csv and\n"
+     "                  surface_faces.csv); kept. Default: a temporary folder, removed unless --keep\n"
+     "  --no-install    fail instead of installing gmsh or calculix-ccx    --quiet  no progress\n"
+     "  Exit status: 0 done, 1 failure (one line: e.g. gmsh could not make a solid of the faces),\n"
+     "  2 bad command line, 3 gmsh or CalculiX missing and not installable.\n"},
+    {"probe", cmd_probe, "REST FRAME POINTS [--slack D]",
+     "a deformed frame at the rest (part, u, v) of points (helper of sem validate)",
+     "  For each point of POINTS (x y z a line, in the files' units): the closest point of REST\n"
+     "  and FRAME's surface point at the same part and (u,v). Prints one line per point:\n"
+     "  part u v distance inside_trim x y z. --slack D: prefer a point inside the trims that is at\n"
+     "  most D farther than the closest (0).\n"},
 };
+
+/* helpers of other commands: runnable, not listed by `sem --help` */
+static int is_hidden(const cli_command *c)
+{
+    return strcmp(c->name, "probe") == 0;
+}
 
 static const int n_commands = (int)(sizeof commands / sizeof commands[0]);
 
@@ -264,7 +302,7 @@ static void print_help(FILE *f)
             "commands:\n",
             sem_version());
     for (int i = 0; i < n_commands; ++i)
-        fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+        if (!is_hidden(&commands[i])) fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 }
 
 static void print_command_help(const cli_command *c)

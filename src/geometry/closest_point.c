@@ -27,6 +27,13 @@ static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1]
 sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *out,
                                      sem_error *err)
 {
+    /* per span: 2 intervals (3 points); Newton from the nearest few finds the rest */
+    return sem_surface_sampler_build_dense(s, 2, out, err);
+}
+
+sem_status sem_surface_sampler_build_dense(const sem_surface *s, int per_span,
+                                           sem_surface_sampler *out, sem_error *err)
+{
     memset(out, 0, sizeof *out);
     out->surface = s;
     double bu[512], bv[512];
@@ -36,8 +43,7 @@ sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *
         bu[0] = s->u0, bu[1] = s->u1, nu = 2;
         bv[0] = s->v0, bv[1] = s->v1, nv = 2;
     }
-    /* per span: 2 intervals (3 points); Newton from the nearest few finds the rest */
-    int per_u = 2, per_v = 2;
+    int per_u = per_span < 1 ? 1 : per_span, per_v = per_u;
     int gu = (nu - 1) * per_u + 1, gv = (nv - 1) * per_v + 1;
     out->n = gu * gv;
     out->uv = malloc((size_t)out->n * 2 * sizeof(double));

@@ -23,6 +23,9 @@ typedef struct sem_surface_sampler {
 
 sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *out,
                                      sem_error *err);
+/* The same with per_span intervals per knot span and direction (>= 1; the plain build uses 2). */
+sem_status sem_surface_sampler_build_dense(const sem_surface *s, int per_span,
+                                           sem_surface_sampler *out, sem_error *err);
 void sem_surface_sampler_free(sem_surface_sampler *sampler);
 
 /* Newton from uv (in: the start, out: the result); returns the distance |S(uv) - p|. */

@@ -7,7 +7,8 @@
 #      name -lsem only: third-party libraries are private) and runs;
 #   3. the same program builds with find_package(sem) against sem::sem and sem::sem_static
 #      and both run;
-#   4. the installed command runs, and its manual page documents every command it lists.
+#   4. the installed command runs, and its manual page documents every command it lists;
+#      sem validate finds its installed scripts (share/sem/fem).
 #   5. the installed Python package imports with no settings (SEM_LIBRARY unset): it finds
 #      the shared library installed beside it.
 # Variables: BUILD_DIR, SOURCE_DIR, PREFIX, LIBDIR, SOVERSION, VERSION, C_COMPILER,
@@ -29,7 +30,8 @@ set(lib ${PREFIX}/${LIBDIR})
 foreach(f bin/sem ${LIBDIR}/libsem.so ${LIBDIR}/libsem.so.${SOVERSION} ${LIBDIR}/libsem.so.${VERSION}
     ${LIBDIR}/libsem.a include/sem/sem.h include/sem/version.h include/sem/model.h
     ${LIBDIR}/pkgconfig/sem.pc ${LIBDIR}/cmake/sem/semConfig.cmake
-    ${LIBDIR}/cmake/sem/semConfigVersion.cmake share/man/man1/sem.1)
+    ${LIBDIR}/cmake/sem/semConfigVersion.cmake share/man/man1/sem.1
+    share/sem/fem/validate.py share/sem/fem/fem_common.py)
   if(NOT EXISTS ${PREFIX}/${f})
     message(FATAL_ERROR "not installed: ${PREFIX}/${f}")
   endif()
@@ -95,6 +97,20 @@ foreach(c ${commands})
   endif()
 endforeach()
 message(STATUS "installed into ${PREFIX}: ${n_commands} commands documented in sem.1")
+
+# sem validate runs the installed tools/fem scripts (share/sem/fem, found from bin/sem), which
+# import each other: a missing model is its one-line error (exit 1) before any FEM work
+foreach(how installed-sem python3-script)
+  if(how STREQUAL "installed-sem")
+    set(cmd ${PREFIX}/bin/sem validate ${work}/missing.igs --no-install)
+  else()
+    set(cmd python3 ${PREFIX}/share/sem/fem/validate.py --sem ${PREFIX}/bin/sem ${work}/missing.igs --no-install)
+  endif()
+  execute_process(COMMAND ${cmd} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 1 OR NOT err MATCHES "^sem: [^\n]*missing.igs: cannot open[^\n]*\n$")
+    message(FATAL_ERROR "sem validate (${how}) on a missing file: exit ${rc}, stderr:\n${err}")
+  endif()
+endforeach()
 
 # 5. the Python package
 if(PYTHON)

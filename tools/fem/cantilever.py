@@ -42,40 +42,25 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fem_common  # noqa: E402
+from fem_common import (HEX20_EDGES, HEX20_FACES, TET10_EDGES, TET10_FACES, cross, read_dat_last_u,  # noqa: E402
+                        read_msh22, sub, to_abaqus, tool_version)
+
 LENGTH, WIDTH, HEIGHT = 5.0, 1.0, 1.0
 RHO, GRAVITY = 1000.0, 10.0
 E, NU = 1.0e6, 0.45
 
 
 def lame():
-    mu = E / (2 * (1 + NU))
-    lam = E * NU / ((1 + NU) * (1 - 2 * NU))
-    K = E / (3 * (1 - 2 * NU))
-    return mu, lam, K
+    return fem_common.lame(E, NU)
 
 
 def ensure_tools(install):
-    missing = [pkg for tool, pkg in (("gmsh", "gmsh"), ("ccx", "calculix-ccx")) if shutil.which(tool) is None]
-    if not missing:
-        return
-    if not install:
-        sys.exit("cantilever.py: missing %s (apt-get install %s)" % (", ".join(missing), " ".join(missing)))
-    print("installing %s with apt-get" % " ".join(missing), file=sys.stderr)
-    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-    subprocess.run(["apt-get", "update", "-qq"], check=True, env=env)
-    subprocess.run(["apt-get", "install", "-y", "-qq"] + missing, check=True, env=env)
-
-
-def tool_version(cmd):
     try:
-        out = subprocess.run(cmd, capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.TimeoutExpired):
-        return "unknown"
-    for line in (out.stdout + out.stderr).splitlines():
-        line = line.strip()
-        if line:
-            return line
-    return "unknown"
+        fem_common.ensure_tools(install, log=lambda m: print(m, file=sys.stderr))
+    except fem_common.ToolsMissing as e:
+        sys.exit("cantilever.py: %s" % e)
 
 
 # ---------------------------------------------------------------- meshing (gmsh)
@@ -105,69 +90,6 @@ Mesh.ElementOrder = 2;
 Mesh.SecondOrderIncomplete = 1;
 Mesh.MshFileVersion = 2.2;
 """ % (WIDTH, ny, HEIGHT, nz, LENGTH, nx)
-
-
-def read_msh22(path):
-    """Nodes {tag: (x, y, z)} and volume elements [(type, [node tags])] of a MSH 2.2 file."""
-    nodes, elems = {}, []
-    with open(path) as f:
-        lines = iter(f.read().splitlines())
-    for line in lines:
-        if line == "$Nodes":
-            n = int(next(lines))
-            for _ in range(n):
-                t = next(lines).split()
-                nodes[int(t[0])] = (float(t[1]), float(t[2]), float(t[3]))
-        elif line == "$Elements":
-            n = int(next(lines))
-            for _ in range(n):
-                t = [int(v) for v in next(lines).split()]
-                etype, ntags = t[1], t[2]
-                if etype in (11, 17):  # 10-node tetrahedron, 20-node hexahedron
-                    elems.append((etype, t[3 + ntags:]))
-    return nodes, elems
-
-
-# Abaqus/CalculiX node orders, 0-based: corners first, then the mid-edge nodes of these edges.
-TET10_EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
-HEX20_EDGES = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4),
-               (0, 4), (1, 5), (2, 6), (3, 7)]
-TET10_FACES = [(0, 1, 2), (0, 1, 3), (1, 2, 3), (0, 2, 3)]
-HEX20_FACES = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-
-
-def sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def to_abaqus(nodes, etype, conn):
-    """Reorders one element into the Abaqus convention. Mid-edge nodes are matched to their
-    edge geometrically (the beam's edges are straight, so each is the exact midpoint of its
-    two corners), which avoids depending on gmsh's internal edge numbering."""
-    nc, edges = (4, TET10_EDGES) if etype == 11 else (8, HEX20_EDGES)
-    corners = list(conn[:nc])
-    if etype == 11:
-        a, b, c, d = (nodes[t] for t in corners)
-        if dot(cross(sub(b, a), sub(c, a)), sub(d, a)) < 0:
-            corners[1], corners[2] = corners[2], corners[1]
-    mids = conn[nc:]
-    out = list(corners)
-    for i, j in edges:
-        pi, pj = nodes[corners[i]], nodes[corners[j]]
-        m = ((pi[0] + pj[0]) / 2, (pi[1] + pj[1]) / 2, (pi[2] + pj[2]) / 2)
-        best = min(mids, key=lambda t: sum((nodes[t][k] - m[k]) ** 2 for k in range(3)))
-        if sum((nodes[best][k] - m[k]) ** 2 for k in range(3)) > 1e-10:
-            raise RuntimeError("mid-edge node not found for edge %d-%d" % (i, j))
-        out.append(best)
-    return out
 
 
 def tip_face_weights(nodes, elements):
@@ -202,31 +124,15 @@ def tip_face_weights(nodes, elements):
 # ---------------------------------------------------------------- solving (CalculiX)
 
 def write_inp(path, nodes, elements, etype_name, linear):
-    mu, lam, K = lame()
     with open(path, "w") as f:
-        f.write("*HEADING\nSEM validation cantilever 5 x 1 x 1 m\n*NODE, NSET=NALL\n")
-        for t in sorted(nodes):
-            x, y, z = nodes[t]
-            f.write("%d, %.12g, %.12g, %.12g\n" % (t, x, y, z))
-        f.write("*ELEMENT, TYPE=%s, ELSET=EALL\n" % etype_name)
-        for k, (etype, conn) in enumerate(elements, start=1):
-            items = [str(k)] + [str(t) for t in conn]
-            # Abaqus input lines hold at most 16 entries; continue on the next line
-            f.write(", ".join(items[:16]))
-            if len(items) > 16:
-                f.write(",\n" + ", ".join(items[16:]))
-            f.write("\n")
+        f.write("*HEADING\nSEM validation cantilever 5 x 1 x 1 m\n")
+        fem_common.write_nodes(f, nodes)
+        fem_common.write_elements(f, [conn for _, conn in elements], etype_name)
         clamp = [t for t in sorted(nodes) if abs(nodes[t][0]) < 1e-9]
         tip = [t for t in sorted(nodes) if abs(nodes[t][0] - LENGTH) < 1e-9]
-        for name, ids in (("NCLAMP", clamp), ("NTIP", tip)):
-            f.write("*NSET, NSET=%s\n" % name)
-            for i in range(0, len(ids), 16):
-                f.write(", ".join(str(t) for t in ids[i:i + 16]) + "\n")
-        f.write("*MATERIAL, NAME=RUBBER\n*DENSITY\n%.12g\n" % RHO)
-        if linear:
-            f.write("*ELASTIC\n%.12g, %.12g\n" % (E, NU))
-        else:
-            f.write("*HYPERELASTIC, NEO HOOKE\n%.12g, %.12g\n" % (mu / 2, 2 / K))
+        fem_common.write_nset(f, "NCLAMP", clamp)
+        fem_common.write_nset(f, "NTIP", tip)
+        fem_common.write_material(f, "RUBBER", RHO, E, NU, "elastic" if linear else "neohookean")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=RUBBER\n")
         f.write("*BOUNDARY\nNCLAMP, 1, 3\n")
         if linear:
@@ -236,27 +142,6 @@ def write_inp(path, nodes, elements, etype_name, linear):
             f.write("*STEP, NLGEOM, INC=1000\n*STATIC\n0.05, 1.0, 1e-6, 0.25\n")
         f.write("*DLOAD\nEALL, GRAV, %.12g, 0., 0., -1.\n" % GRAVITY)
         f.write("*NODE PRINT, NSET=NTIP\nU\n*END STEP\n")
-
-
-def read_dat_last_u(path):
-    """Displacements of the last printed block: {node: (ux, uy, uz)}."""
-    u, cur = {}, None
-    with open(path) as f:
-        for line in f:
-            s = line.strip()
-            if s.startswith("displacements"):
-                cur = {}
-                u = cur
-                continue
-            if cur is None or not s:
-                continue
-            t = s.split()
-            if len(t) == 4:
-                try:
-                    cur[int(t[0])] = tuple(float(v) for v in t[1:])
-                except ValueError:
-                    cur = None
-    return u
 
 
 def solve(workdir, job, h, element, linear):
@@ -273,13 +158,10 @@ def solve(workdir, job, h, element, linear):
     used = set(t for _, conn in elements for t in conn)
     nodes = {t: nodes[t] for t in used}
     write_inp(os.path.join(workdir, job + ".inp"), nodes, elements, element, linear)
-    env = dict(os.environ, OMP_NUM_THREADS="2", CCX_NPROC_EQUATION_SOLVER="2")
-    t0 = time.time()
-    run = subprocess.run(["ccx", "-i", job], cwd=workdir, capture_output=True, text=True, env=env)
-    seconds = time.time() - t0
-    if run.returncode != 0 or "Job finished" not in run.stdout:
-        tail = "\n".join((run.stdout + run.stderr).splitlines()[-15:])
-        raise RuntimeError("ccx failed for %s:\n%s" % (job, tail))
+    try:
+        seconds = fem_common.run_ccx(workdir, job, threads=2)
+    except fem_common.ToolFailed as e:
+        raise RuntimeError(str(e))
     u = read_dat_last_u(os.path.join(workdir, job + ".dat"))
     w = tip_face_weights(nodes, elements)
     area = sum(w.values())
