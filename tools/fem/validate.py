@@ -110,6 +110,8 @@ def parse_args(argv):
     ap.add_argument("--max-nodes", type=int, default=40000)
     ap.add_argument("--h0", type=float)
     ap.add_argument("-E", "--youngs-modulus", type=float, dest="youngs_modulus")
+    ap.add_argument("--resolutions", help="comma-separated sem.resolution values: sem solved again at each, "
+                    "against the same FEM answer (the accuracy setting's convergence)")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     if not (0 < a.tolerance < 1):
@@ -122,6 +124,14 @@ def parse_args(argv):
         ap.error("--h0 must be a positive length (got %g)" % a.h0)
     if a.youngs_modulus is not None and not (a.youngs_modulus > 0 and math.isfinite(a.youngs_modulus)):
         ap.error("--youngs-modulus must be positive (got %g)" % a.youngs_modulus)
+    a.resolution_list = []
+    if a.resolutions:
+        try:
+            a.resolution_list = [float(x) for x in a.resolutions.split(",")]
+        except ValueError:
+            ap.error("--resolutions must be numbers separated by commas (got %s)" % a.resolutions)
+        if any(not (0 <= r <= 1000) for r in a.resolution_list):
+            ap.error("--resolutions must be in 0..1000")
     return a
 
 
@@ -584,6 +594,13 @@ def text_report(r):
     md = cmp_["max_displacement"]
     lines.append("largest   displacement FEM %s, sem %s: ratio sem / FEM %.3f" % (
         fmt_len(md["fem_m"]), fmt_len(md["sem_m"]), md["ratio"]))
+    for e in r.get("resolutions") or []:
+        if e.get("error"):
+            lines.append("resolution %g: %s" % (e["resolution"], e["error"]))
+        else:
+            lines.append("resolution %-5g %6d dofs, %4s parts: L2 error %.2f %%, largest displacement ratio %.3f "
+                         "(%.1f s, %s)" % (e["resolution"], e["dofs"], e["parts"], 100 * e["l2_error"], e["max_ratio"],
+                                          e["seconds"], e["status"]))
     if r.get("workdir"):
         lines.append("files     %s" % r["workdir"])
     return "\n".join(lines)
@@ -832,8 +849,46 @@ def validate(args, workdir):
         for face, _ in fem_mesh.faces:
             f.write(",".join(str(t) for t in face) + "\n")
 
+    # the accuracy setting: sem again at each resolution, against the same FEM answer
+    sweep = []
+    for R in args.resolution_list:
+        sdir = os.path.join(workdir, "sem_r%g" % R)
+        sc = json.loads(json.dumps(scene))
+        sc["objects"][0].setdefault("sem", {})["resolution"] = R
+        sc["output"]["dir"] = sdir
+        spath = os.path.join(workdir, "sem_scene_r%g.json" % R)
+        with open(spath, "w") as f:
+            json.dump(sc, f, indent=1)
+        log("sem: static solve at resolution %g" % R)
+        t0 = time.time()
+        try:
+            o2, e2 = sem.run(["run", spath, "--out", sdir, "--overwrite", "--json", "--quiet"], "sem run")
+        except Fail as e:
+            sweep.append({"resolution": R, "error": str(e)})
+            continue
+        secs = time.time() - t0
+        s2 = json.loads(o2)
+        r2 = probe(sem, workdir, os.path.join(sdir, "frame_0000.igs"), os.path.join(sdir, "frame_0001.igs"),
+                   [fem_mesh.nodes[t] for t in ids], 1.0 / f2m, tol_on / f2m)
+        us = {}
+        for t, (part, uu, vv, dist, inside, x) in zip(ids, r2):
+            if t in used:
+                us[t] = tuple(x[c] * f2m - fem_mesh.nodes[t][c] for c in range(3))
+        fu = [(f, a) for f, a in faces_used if all(t in us for t in f)]
+        d2 = {t: tuple(us[t][c] - fem_u[t][c] for c in range(3)) for t in us}
+        lf, mf = surface_norms(fu, fem_u)
+        ls, ms = surface_norms(fu, us)
+        ld, _ = surface_norms(fu, d2)
+        entry = {"resolution": R, "dofs": s2["dofs"], "parts": (s2.get("objects") or [{}])[0].get("parts"),
+                 "seconds": round(secs, 2), "solve_s": s2.get("mean_step_s"), "status": s2.get("status"),
+                 "l2_error": ld / lf if lf > 0 else None, "max_ratio": ms / mf if mf > 0 else None}
+        sweep.append(entry)
+        log("sem at resolution %g: %d dofs, L2 error %.1f %%, largest displacement ratio %.3f (%.1f s)" % (
+            R, entry["dofs"], 100 * (entry["l2_error"] or 0), entry["max_ratio"] or 0, secs))
+
     frames = summary.get("frames") or []
     return {
+        "resolutions": sweep,
         "model": args.model,
         "scene": args.scene,
         "file_units": info.get("units"),
