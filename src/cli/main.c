@@ -98,7 +98,7 @@ static const cli_command commands[] = {
      "  The page bundles three.js from the Debian package libjs-three\n"
      "  (/usr/share/javascript/three; SEM_THREE_DIR overrides the folder).\n"},
     {"validate", cmd_validate,
-     "MODEL [SCENE] [--json] [--tolerance T] [--workdir DIR] [--keep] [--no-install] [--max-levels N] [--max-nodes N] [--h0 H] [-E E] [--quiet]",
+     "MODEL [SCENE] [--json] [--tolerance T] [--workdir DIR] [--keep] [--no-install] [--max-levels N] [--max-nodes N] [--h0 H] [-E E] [--resolutions R1,R2,...] [--quiet]",
      "sem against a converged FEM solution (gmsh + CalculiX) of the same static sag",
      "  Meshes MODEL with gmsh (Open CASCADE, faces sewn into solids) into quadratic tetrahedra,\n"
      "  solves the static sag under gravity with CalculiX (neo-Hookean, NLGEOM), refining the mesh\n"
@@ -118,6 +118,8 @@ static const cli_command commands[] = {
      "  --max-nodes N   no mesh with more than N nodes (40000)\n"
      "  --h0 H          first characteristic length, metres (the largest dimension / 10)\n"
      "  -E, --youngs-modulus E   Young's modulus, Pa, instead of the 1 % rule or the scene's\n"
+     "  --resolutions R1,R2,...  sem solved again at each sem.resolution (the accuracy setting),\n"
+     "                  each against the same FEM answer: dofs, L2 error, largest-displacement ratio\n"
      "  --workdir DIR   work in DIR (meshes, CalculiX files, sem's frames, surface_nodes.csv and\n"
      "                  surface_faces.csv); kept. Default: a temporary folder, removed unless --keep\n"
      "  --no-install    fail instead of installing gmsh or calculix-ccx    --quiet  no progress\n"

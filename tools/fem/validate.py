@@ -52,7 +52,7 @@ import fem_common  # noqa: E402
 from fem_common import ToolFailed, ToolsMissing  # noqa: E402
 
 USAGE = ("MODEL [SCENE] [--json] [--tolerance T] [--workdir DIR] [--keep] [--no-install] "
-         "[--max-levels N] [--max-nodes N] [--h0 H] [-E E] [--quiet]")
+         "[--max-levels N] [--max-nodes N] [--h0 H] [-E E] [--resolutions R1,R2,...] [--quiet]")
 EXIT_FAILED, EXIT_USAGE, EXIT_TOOLS = 1, 2, 3
 
 DEFAULT_DENSITY, DEFAULT_E, DEFAULT_NU = 1000.0, 1.0e6, 0.45
