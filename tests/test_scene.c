@@ -97,6 +97,9 @@ static void test_errors(void)
     expect_error(BOX ", \"sem\": {\"sparsity\": 1}", "", "objects[0].sem.sparsity", "(0, 1)");
     expect_error(BOX ", \"sem\": {\"order\": 3}", "", "objects[0].sem.order", "1 or 2");
     expect_error(BOX ", \"sem\": {\"seams\": \"blended\"}", "", "objects[0].sem.seams", "\"geometric\" or \"paper\"");
+    expect_error(BOX ", \"sem\": {\"resolution\": -1}", "", "objects[0].sem.resolution", "0..1000");
+    expect_error(BOX ", \"sem\": {\"resolution\": 1001}", "", "objects[0].sem.resolution", "0..1000");
+    expect_error(BOX ", \"sem\": {\"weld\": 1}", "", "objects[0].sem.weld", "true or false");
     expect_error(BOX ", \"sem\": {\"fit\": \"faces\"}", "", "objects[0].sem.fit", "\"auto\", \"parts\" or \"origins\"");
     expect_error(BOX ", \"sem\": {\"alpha\": 1, \"sparsity\": 0.5}", "", "objects[0].sem: give either", "not both");
     expect_error(BOX ", \"sem\": {\"rays\": [0, 4]}", "", "objects[0].sem.rays", NULL);
@@ -594,8 +597,68 @@ static void test_frame_model_units(void)
     sem_scene_destroy(s);
 }
 
+/* sem.resolution: the world simulates the patches (welded), the frames show the file's parts
+ * refined at the cuts (the patches' points gathered back), part selections name the file's
+ * parts, control point selections are refused. */
+static void test_resolution(void)
+{
+    sem_error err;
+    const char *json =
+        "{\"objects\": [{\"primitive\": {\"type\": \"beam\", \"sections\": 1, \"length\": 2, \"width\": 0.4,"
+        " \"height\": 0.4}, \"sem\": {\"resolution\": 4, \"order\": 1},"
+        " \"pin\": {\"parts\": [0]}, \"part_materials\": {\"1\": {\"youngs_modulus\": 2e6}}}],"
+        " \"integrator\": {\"type\": \"linearly_implicit_euler\", \"dt\": 0.01}}";
+    sem_scene *s = parse(json, &err);
+    CHECK(s != NULL, "scene: %s", s ? "" : err.message);
+    if (!s) return;
+    sem_scene_world_options options = sem_default_scene_world_options();
+    options.skip_modes = 1;
+    sem_scene_world *sw = NULL;
+    CHECK(sem_scene_world_create(s, &options, &sw, &err) == SEM_OK, "world: %s", err.message);
+    if (sw) {
+        const sem_model *sim = sem_scene_world_model(sw, 0), *shown = sem_scene_world_output_model(sw, 0);
+        /* 2 x 0.4 x 0.4 beam, diagonal 2.08, patches <= 0.52: each long face 4 x 1 */
+        CHECK(shown->n_parts == 6, "frames show %d parts, the file has 6", shown->n_parts);
+        CHECK(sim->n_parts == 2 + 4 * 4, "the world simulates %d patches, want 18", sim->n_parts);
+        sem_world *w = sem_scene_world_world(sw);
+        for (int k = 0; k < 2; ++k) CHECK(sem_world_step(w, &err) == SEM_OK, "step: %s", err.message);
+        size_t ns = sem_model_control_points(shown);
+        double *x = malloc(3 * ns * sizeof *x);
+        sem_model *frame = NULL;
+        CHECK(sem_scene_world_frame_model(sw, 0, &frame, &err) == SEM_OK && frame, "frame model: %s", err.message);
+        if (x && frame) {
+            sem_scene_world_output_q(sw, 0, sem_world_object_q(w, 0), x);
+            double *y = malloc(3 * ns * sizeof *y);
+            if (y) {
+                sem_model_get_q(frame, y);
+                int same = sem_model_control_points(frame) == ns;
+                for (size_t i = 0; same && i < 3 * ns; ++i) same = y[i] == x[i];
+                CHECK(same, "the frame model is not the gathered state");
+                free(y);
+            }
+        }
+        sem_model_destroy(frame);
+        free(x);
+        sem_scene_world_destroy(sw);
+    }
+    sem_scene_destroy(s);
+    /* control points of the file cannot be named: they are refined */
+    s = parse("{\"objects\": [{\"primitive\": {\"type\": \"box\"}, \"sem\": {\"resolution\": 4},"
+              " \"pin\": {\"points\": [0]}}]}",
+              &err);
+    if (s) {
+        sw = NULL;
+        CHECK(sem_scene_world_create(s, &options, &sw, &err) == SEM_ERR_INVALID && !sw &&
+                  strstr(err.message, "pin.points") && strstr(err.message, "sem.resolution"),
+              "pin.points with a resolution: %s", err.message);
+        sem_scene_world_destroy(sw);
+        sem_scene_destroy(s);
+    }
+}
+
 int main(void)
 {
+    test_resolution();
     test_strict_json();
     test_frame_model_units();
     test_errors();
