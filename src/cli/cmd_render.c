@@ -27,6 +27,7 @@
 #include "cli.h"
 #include "render_input.h"
 #include "sem/render.h"
+#include "util/make_dirs.h"
 
 #define CMD "render"
 
@@ -171,21 +172,6 @@ static int in_path(const char *name)
     return 0;
 }
 
-static int make_dirs(const char *path)
-{
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; ++p)
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
-            *p = '/';
-        }
-    if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
-    struct stat st;
-    return stat(tmp, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
-}
-
 /* MODEL.png in the current folder for path/MODEL.ext */
 static void default_picture(const char *model, char *out, size_t size)
 {
@@ -321,8 +307,9 @@ int cmd_render(int argc, char **argv)
             snprintf(dir, sizeof dir, "%s", o.output);
         else
             snprintf(dir, sizeof dir, "%s/render", in.run.dir);
-        if (make_dirs(dir) != 0) {
-            cli_fail("%s: cannot create folder: %s", dir, strerror(errno));
+        sem_error derr;
+        if (sem_make_dirs(dir, &derr) != SEM_OK) {
+            cli_fail_error(NULL, &derr);
             goto done;
         }
     } else if (o.output) {

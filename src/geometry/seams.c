@@ -196,20 +196,18 @@ static void pair_list_free(pair_list *l)
 
 /* The point of part b nearest X that lies on b (inside its trim), if within tol:
  * 1 and uv set, else 0. */
-static int partner(const sem_part *part, const sem_surface_sampler *sampler, const sem_trim_region *region,
-                   const point_list *boundary, const double X[3], double tol, double uv[2], double *distance)
+static int partner(const sem_surface_sampler *sampler, const sem_trim_region *region, const point_list *boundary,
+                   const double X[3], double tol, double uv[2], double *distance)
 {
     double t[2];
     double d = sem_surface_closest_point(sampler, X, NULL, 0.0, t);
-    (void)part;
     if (d <= tol && sem_trim_region_inside(region, t[0], t[1])) {
         uv[0] = t[0], uv[1] = t[1];
         *distance = d;
         return 1;
     }
-    /* on b's trim boundary: its nearest boundary point, refined along the polygon between
-     * its neighbours would be finer; the boundary points are SPACING L apart, so the pair
-     * is taken only when one of them is itself within tol */
+    /* on b's trim boundary: its nearest boundary point (the points are SPACING L apart, so
+     * the pair is taken only when one of them is itself within tol) */
     int best = -1;
     double bd = tol;
     for (int i = 0; i < boundary->n; ++i) {
@@ -319,7 +317,7 @@ sem_status sem_seams_build(const sem_model *model, double tolerance, sem_seams *
                     X[1] > bb[4] + tol || X[2] > bb[5] + tol)
                     continue;
                 double uv[2], d;
-                if (!partner(&model->parts[b], &samplers[b], regions[b], &boundary[b], X, tol, uv, &d)) continue;
+                if (!partner(&samplers[b], regions[b], &boundary[b], X, tol, uv, &d)) continue;
                 if (pair_push(&pairs[a], a, boundary[a].uv + 2 * (size_t)i, b, uv, d) != 0) {
                     failed = 1;
                     break;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "gltf.h"
+#include "util/make_dirs.h"
 #include "io/atomic_file.h"
 #include "preprocess_view.h"
 #include "sem/preprocess.h"
@@ -33,22 +34,6 @@ struct sem_animation {
     float **frame_normals;        /* the same for normals (glTF only) */
     size_t points_per_frame;      /* floats */
 };
-
-static sem_status make_dirs(const char *path, sem_error *err)
-{
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; ++p) {
-        if (*p != '/') continue;
-        *p = '\0';
-        if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
-            return sem_error_set(err, SEM_ERR_IO, "%s: cannot create folder: %s", tmp, strerror(errno));
-        *p = '/';
-    }
-    if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
-        return sem_error_set(err, SEM_ERR_IO, "%s: cannot create folder: %s", tmp, strerror(errno));
-    return SEM_OK;
-}
 
 sem_status sem_animation_check_dir(const char *dir, sem_error *err)
 {
@@ -99,7 +84,7 @@ sem_status sem_animation_create(const sem_animation_def *def, int n_objects,
     snprintf(a->usd_path, sizeof a->usd_path, "%s/animation.usda", a->dir);
     snprintf(a->glb_path, sizeof a->glb_path, "%s/animation.glb", a->dir);
     a->n_objects = n_objects;
-    sem_status st = make_dirs(a->dir, err);
+    sem_status st = sem_make_dirs(a->dir, err);
     if (st != SEM_OK) goto fail;
     a->combined = sem_model_create();
     a->object_ctrl = calloc((size_t)n_objects + 1, sizeof(size_t));

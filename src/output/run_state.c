@@ -15,6 +15,7 @@
 
 #include "io/atomic_file.h"
 #include "io/read_file.h"
+#include "util/fnv_hash.h"
 
 static const char state_magic[8] = {'S', 'E', 'M', 'S', 'T', 'A', 'T', 'E'};
 #define STATE_VERSION 1u
@@ -29,39 +30,25 @@ int sem_run_frame_digits(int frames)
     return d < 4 ? 4 : d;
 }
 
-typedef struct fnv {
-    uint64_t h;
-} fnv;
-
-static void fnv_init(fnv *f) { f->h = 14695981039346656037ull; }
-
-static void fnv_bytes(fnv *f, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; ++i) {
-        f->h ^= p[i];
-        f->h *= 1099511628211ull;
-    }
-}
 
 unsigned long long sem_run_text_hash(const char *text, size_t len)
 {
-    fnv f;
-    fnv_init(&f);
-    fnv_bytes(&f, text, len);
+    sem_fnv f;
+    sem_fnv_init(&f);
+    sem_fnv_bytes(&f, text, len);
     return f.h;
 }
 
 unsigned long long sem_run_id(const sem_run_info *info)
 {
-    fnv f;
-    fnv_init(&f);
-    fnv_bytes(&f, info->scene_path, strlen(info->scene_path));
-    fnv_bytes(&f, &info->scene_hash, sizeof info->scene_hash);
+    sem_fnv f;
+    sem_fnv_init(&f);
+    sem_fnv_bytes(&f, info->scene_path, strlen(info->scene_path));
+    sem_fnv_bytes(&f, &info->scene_hash, sizeof info->scene_hash);
     int sizes[4] = {info->frames, info->steps_per_frame, info->digits, info->n_objects};
-    fnv_bytes(&f, sizes, sizeof sizes);
+    sem_fnv_bytes(&f, sizes, sizeof sizes);
     int n = info->n_objects < 64 ? info->n_objects : 64;
-    fnv_bytes(&f, info->object_hash, (size_t)n * sizeof info->object_hash[0]);
+    sem_fnv_bytes(&f, info->object_hash, (size_t)n * sizeof info->object_hash[0]);
     return f.h;
 }
 
@@ -170,10 +157,10 @@ static void state_path(const char *dir, int digits, int frame, char *out, size_t
     snprintf(out, size, "%s/state/frame_%0*d.state", dir, digits, frame);
 }
 
-static void put(FILE *f, fnv *sum, const void *data, size_t n)
+static void put(FILE *f, sem_fnv *sum, const void *data, size_t n)
 {
     fwrite(data, 1, n, f);
-    fnv_bytes(sum, data, n);
+    sem_fnv_bytes(sum, data, n);
 }
 
 sem_status sem_run_state_write(const char *dir, int digits, unsigned long long run_id,
@@ -184,8 +171,8 @@ sem_status sem_run_state_write(const char *dir, int digits, unsigned long long r
     sem_atomic_file f;
     sem_status st = sem_atomic_open(&f, path, err);
     if (st != SEM_OK) return st;
-    fnv sum;
-    fnv_init(&sum);
+    sem_fnv sum;
+    sem_fnv_init(&sum);
     uint32_t version = STATE_VERSION, bom = STATE_BYTE_ORDER;
     uint64_t id = run_id;
     int32_t frame = s->frame, n_objects = s->n_objects, n_stats = s->n_stats;
@@ -252,9 +239,9 @@ sem_status sem_run_state_read(const char *dir, int digits, int frame, unsigned l
     if (size < sizeof state_magic + 8 || memcmp(data, state_magic, sizeof state_magic) != 0) {
         bad = "not a sem state file";
     } else {
-        fnv sum;
-        fnv_init(&sum);
-        fnv_bytes(&sum, data, size - 8);
+        sem_fnv sum;
+        sem_fnv_init(&sum);
+        sem_fnv_bytes(&sum, data, size - 8);
         uint64_t stored;
         memcpy(&stored, data + size - 8, 8);
         if (stored != sum.h) bad = "damaged or incomplete (checksum mismatch)";

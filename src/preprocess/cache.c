@@ -11,6 +11,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "util/make_dirs.h"
+
 #define ENTRY_SUFFIX ".semdisc"
 /* a temporary older than this was left by a writer that was killed */
 #define STALE_TEMPORARY_SECONDS 3600
@@ -54,24 +56,13 @@ sem_status sem_cache_load(const char *dir, const sem_model *model,
     return SEM_OK;
 }
 
-static void make_dirs(const char *path)
-{
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; ++p)
-        if (*p == '/') {
-            *p = '\0';
-            mkdir(tmp, 0777);
-            *p = '/';
-        }
-    mkdir(tmp, 0777);
-}
-
 sem_status sem_cache_store(const char *dir, long long max_bytes, const sem_model *model,
                            const sem_preprocess_options *options, const sem_discretization *d,
                            sem_error *err)
 {
-    make_dirs(dir);
+    /* a folder that cannot be made fails the store below, naming the file */
+    sem_error ignored;
+    sem_make_dirs(dir, &ignored);
     char path[4200];
     sem_cache_entry_path(dir, model, options, path, sizeof path);
     sem_status st = sem_discretization_save(d, path, err);

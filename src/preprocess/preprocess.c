@@ -40,6 +40,7 @@
 #include "io/read_file.h"
 #include "sem/limits.h"
 #include "steps.h"
+#include "util/fnv_hash.h"
 
 /* The file stores int arrays as 32-bit integers and reads them straight into int arrays. */
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
@@ -142,31 +143,14 @@ static sem_status validate_options(const sem_preprocess_options *o, sem_error *e
 /* ------------------------------------------------------------------------------------ */
 /* hash (FNV-1a 64)                                                                      */
 
-typedef struct fnv {
-    uint64_t h;
-} fnv;
-
-static void fnv_init(fnv *f) { f->h = 14695981039346656037ull; }
-
-static void fnv_bytes(fnv *f, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    uint64_t h = f->h;
-    for (size_t k = 0; k < n; ++k) {
-        h ^= p[k];
-        h *= 1099511628211ull;
-    }
-    f->h = h;
-}
-
-static void fnv_int(fnv *f, int v)
+static void fnv_int(sem_fnv *f, int v)
 {
     int32_t x = (int32_t)v;
-    fnv_bytes(f, &x, sizeof x);
+    sem_fnv_bytes(f, &x, sizeof x);
 }
 
 /* -0.0 hashes as 0.0 so equal numbers give equal hashes. */
-static void fnv_doubles(fnv *f, const double *v, size_t n)
+static void fnv_doubles(sem_fnv *f, const double *v, size_t n)
 {
     if (!v) {
         fnv_int(f, -1);
@@ -174,11 +158,11 @@ static void fnv_doubles(fnv *f, const double *v, size_t n)
     }
     for (size_t k = 0; k < n; ++k) {
         double x = v[k] == 0.0 ? 0.0 : v[k];
-        fnv_bytes(f, &x, sizeof x);
+        sem_fnv_bytes(f, &x, sizeof x);
     }
 }
 
-static void hash_curve(fnv *f, const sem_curve *c)
+static void hash_curve(sem_fnv *f, const sem_curve *c)
 {
     fnv_int(f, c->degree);
     fnv_int(f, c->n_ctrl);
@@ -190,7 +174,7 @@ static void hash_curve(fnv *f, const sem_curve *c)
     fnv_doubles(f, &c->t1, 1);
 }
 
-static void hash_loop(fnv *f, const sem_trim_loop *l)
+static void hash_loop(sem_fnv *f, const sem_trim_loop *l)
 {
     fnv_int(f, l->n_curves);
     for (int k = 0; k < l->n_curves && l->curves; ++k) hash_curve(f, &l->curves[k]);
@@ -225,9 +209,9 @@ int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options 
 
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o)
 {
-    fnv f;
-    fnv_init(&f);
-    fnv_bytes(&f, sem_disc_magic, sizeof sem_disc_magic);
+    sem_fnv f;
+    sem_fnv_init(&f);
+    sem_fnv_bytes(&f, sem_disc_magic, sizeof sem_disc_magic);
     fnv_int(&f, (int)SEM_DISC_FORMAT_VERSION);
     if (model) {
         fnv_int(&f, model->n_parts);
@@ -559,14 +543,14 @@ done:
 
 typedef struct writer {
     FILE *f;
-    fnv sum;
+    sem_fnv sum;
     int failed;
 } writer;
 
 static void w_bytes(writer *w, const void *data, size_t n)
 {
     if (w->failed || n == 0) return;
-    fnv_bytes(&w->sum, data, n);
+    sem_fnv_bytes(&w->sum, data, n);
     if (fwrite(data, 1, n, w->f) != n) w->failed = 1;
 }
 
@@ -622,7 +606,7 @@ sem_status sem_discretization_save(const sem_discretization *d, const char *path
         free(tmp);
         return st;
     }
-    fnv_init(&w.sum);
+    sem_fnv_init(&w.sum);
     w_bytes(&w, sem_disc_magic, sizeof sem_disc_magic);
     w_u32(&w, SEM_DISC_FORMAT_VERSION);
     w_u32(&w, SEM_DISC_BYTE_ORDER);
@@ -901,9 +885,9 @@ sem_status sem_discretization_load_buffer(const char *name, const void *bytes, s
                              path, (unsigned)version, (unsigned)SEM_DISC_FORMAT_VERSION);
     }
     /* checksum of everything before the last 8 bytes */
-    fnv sum;
-    fnv_init(&sum);
-    fnv_bytes(&sum, data, size - 8);
+    sem_fnv sum;
+    sem_fnv_init(&sum);
+    sem_fnv_bytes(&sum, data, size - 8);
     uint64_t stored;
     memcpy(&stored, data + size - 8, 8);
     if (stored != sum.h) {
