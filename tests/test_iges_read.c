@@ -505,6 +505,38 @@ static void test_model_space_trims(void)
     sem_model_destroy(m);
 }
 
+/* Unbounded 108 planes (PTR = 0) with a display size, each trimmed by a 144 whose loops are
+ * in model space only (tests/data/iges_generate.py, file_unbounded_planes): every plane is
+ * sized by its boundary, not by the 1.0 display symbol drawn far away, so the box's faces
+ * have their areas (the top one with a hole of radius 0.5) and the box its extent. Before,
+ * each face was a 2 x 2 square at the display point and every loop was left out ("16 away
+ * from its surface"). */
+static void test_unbounded_planes(void)
+{
+    sem_model *m = load_data("iges_unbounded_planes.igs");
+    if (!m) return;
+    CHECK(m->n_parts == 6, "parts %d", m->n_parts);
+    CHECK(m->n_warnings == 0, "warnings %d: %s", m->n_warnings, m->n_warnings ? m->warnings[0] : "");
+    if (m->n_parts == 6) {
+        const double expected[6] = {12, 12 - M_PI / 4, 6, 6, 8, 8};
+        for (int i = 0; i < 6; ++i) {
+            sem_part_measure_result r;
+            CHECK(sem_part_measure(&m->parts[i], &r, NULL) == SEM_OK, "measure part %d", i);
+            CHECK(fabs(r.area - expected[i]) < (i == 1 ? 1e-4 : 1e-12) * expected[i],
+                  "part %d area %.9g, expected %.9g", i, r.area, expected[i]);
+        }
+        CHECK(m->parts[1].n_holes == 1 && trimmed_parts(m) == 1, "only the top face is trimmed");
+        sem_part_measure_result total;
+        CHECK(sem_model_measure(m, NULL, &total, NULL) == SEM_OK, "measure");
+        const double hi[3] = {4, 3, 2};
+        for (int d = 0; d < 3; ++d) {
+            CHECK(fabs(total.bbox_min[d]) < 1e-12, "bbox min %d: %g", d, total.bbox_min[d]);
+            CHECK(fabs(total.bbox_max[d] - hi[d]) < 1e-12, "bbox max %d: %g", d, total.bbox_max[d]);
+        }
+    }
+    sem_model_destroy(m);
+}
+
 /* unknown geometric entity: a warning naming it; colour/property/note entities: silence */
 static void test_unknown_entity_warning(void)
 {
@@ -671,6 +703,7 @@ int main(void)
     test_brep();
     test_model_space_trims();
     test_analytic_surfaces();
+    test_unbounded_planes();
     test_unknown_entity_warning();
     test_cad_trimmed();
     test_missing_bptr();

@@ -1427,8 +1427,10 @@ static void set_bilinear(sem_surface *s, const double o[3], const double e1[3],
 /* 108: the plane A x + B y + C z = D. A bounded plane (PTR to a closed curve) becomes the
  * bilinear patch over the bounding box of the curve's control points in an orthonormal
  * frame of the plane, trimmed by that curve mapped into the frame (an affine map, so the
- * trim curve is exact). An unbounded plane with a display SIZE becomes the square of half
- * side SIZE centred at the display point projected onto the plane. */
+ * trim curve is exact). An unbounded plane (PTR = 0) inside a trimmed entity or face with
+ * model-space boundary curves is fitted to that boundary (surface_hint); elsewhere, with a
+ * display SIZE, it becomes the square of half side SIZE centred at the display point
+ * projected onto the plane. */
 static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
 {
     double a[4], xyz[3], size;
@@ -1459,7 +1461,11 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     double o[3] = {xyz[0] - off * n[0], xyz[1] - off * n[1], xyz[2] - off * n[2]};
     if (sem_surface_alloc(&part->surface, 1, 1, 2, 2) != SEM_OK) return nomem(r);
     if (ptr < 0) {
-        if (!(size > 0) && r->surface_hint) {
+        /* An unbounded plane inside a trimmed entity or face is sized by that boundary, with
+         * or without a display size: SIZE only says how large to draw the plane's symbol
+         * (CATIA writes 1.0 whatever the face), and taking it as the extent left the
+         * boundary off the surface (occt_cone_catia, occt_cylinder_catia in the corpus). */
+        if (r->surface_hint) {
             set_bilinear(&part->surface, o, e1, e2, -1.0, 1.0, -1.0, 1.0);
             r->from_hint = 1;
             r->hint_fit = HINT_PLANE;

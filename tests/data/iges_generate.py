@@ -531,6 +531,44 @@ def file_analytic():
     save("iges_analytic.igs", build(E))
 
 
+def file_unbounded_planes():
+    """A box [0,4] x [0,3] x [0,2] (millimetres) as CATIA and FreeCAD write planar faces:
+    each face a 144 on an unbounded 108 plane (PTR = 0) whose display symbol is 1.0 wide
+    and drawn at a point far from the face, trimmed by a 142 with model-space curves only
+    (BPTR = 0, PREF 2). The top face has a hole of radius 0.5 around (2, 1.5) (a 100 arc
+    at ZT = 2). The display size must not bound the plane: areas 12, 12 - pi / 4, 6, 6,
+    8, 8 (the corpus files occt_cone_catia and occt_cylinder_catia lost their caps)."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    box = [(0, 0, 0), (4, 0, 0), (4, 3, 0), (0, 3, 0),
+           (0, 0, 2), (4, 0, 2), (4, 3, 2), (0, 3, 2)]
+    # faces: plane coefficients (A, B, C, D) and the corners in loop order
+    faces = [((0, 0, -1, 0), (0, 3, 2, 1)), ((0, 0, 1, 2), (4, 5, 6, 7)),
+             ((-1, 0, 0, 0), (0, 4, 7, 3)), ((1, 0, 0, 4), (1, 2, 6, 5)),
+             ((0, -1, 0, 0), (0, 1, 5, 4)), ((0, 1, 0, 3), (3, 7, 6, 2))]
+    for k, (abcd, corners) in enumerate(faces):
+        t144 = add(None)
+        display = (100.0 + k, -50.0, 75.0)
+        plane = add(Ent(108, [r(x) for x in abcd] + ["0"] + [r(x) for x in display] + ["1.0"],
+                        status=sub))
+        lines = [add(Ent(110, line(box[corners[i]], box[corners[(i + 1) % 4]]), status=sub))
+                 for i in range(4)]
+        comp = add(Ent(102, ["4"] + [de(i) for i in lines], status=sub))
+        outer = add(Ent(142, ["0", de(plane), "0", de(comp), "2"], status=sub))
+        params = [de(plane), "1", "0", de(outer)]
+        if k == 1:
+            hole = add(Ent(100, ["2.0", "2.0", "1.5", "2.5", "1.5", "2.5", "1.5"], status=sub))
+            inner = add(Ent(142, ["0", de(plane), "0", de(hole), "2"], status=sub))
+            params = [de(plane), "1", "1", de(outer), de(inner)]
+        E[t144] = Ent(144, params)
+    save("iges_unbounded_planes.igs", build(E, unit_flag=2, unit_name="MM"))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -601,4 +639,5 @@ if __name__ == "__main__":
     file_model_space()
     file_model_space("iges_model_space_near.igs", 1e-4)
     file_analytic()
+    file_unbounded_planes()
     errors()
