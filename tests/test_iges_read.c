@@ -510,25 +510,31 @@ static void test_model_space_trims(void)
  * sized by its boundary, not by the 1.0 display symbol drawn far away, so the box's faces
  * have their areas (the top one with a hole of radius 0.5) and the box its extent. Before,
  * each face was a 2 x 2 square at the display point and every loop was left out ("16 away
- * from its surface"). */
+ * from its surface"). Two 143s list a hole before the outer boundary (I-DEAS): the outer loop
+ * is the one that holds the others. */
 static void test_unbounded_planes(void)
 {
     sem_model *m = load_data("iges_unbounded_planes.igs");
     if (!m) return;
-    CHECK(m->n_parts == 6, "parts %d", m->n_parts);
+    CHECK(m->n_parts == 8, "parts %d", m->n_parts);
     CHECK(m->n_warnings == 0, "warnings %d: %s", m->n_warnings, m->n_warnings ? m->warnings[0] : "");
-    if (m->n_parts == 6) {
-        const double expected[6] = {12, 12 - M_PI / 4, 6, 6, 8, 8};
-        for (int i = 0; i < 6; ++i) {
+    if (m->n_parts == 8) {
+        const double expected[8] = {12, 12 - M_PI / 4, 6, 6, 8, 8, 18 - M_PI, 12 - M_PI / 4};
+        for (int i = 0; i < 8; ++i) {
             sem_part_measure_result r;
+            int trimmed = i == 1 || i >= 6;
             CHECK(sem_part_measure(&m->parts[i], &r, NULL) == SEM_OK, "measure part %d", i);
-            CHECK(fabs(r.area - expected[i]) < (i == 1 ? 1e-4 : 1e-12) * expected[i],
+            CHECK(fabs(r.area - expected[i]) < (trimmed ? 1e-4 : 1e-12) * expected[i],
                   "part %d area %.9g, expected %.9g", i, r.area, expected[i]);
         }
-        CHECK(m->parts[1].n_holes == 1 && trimmed_parts(m) == 1, "only the top face is trimmed");
+        CHECK(m->parts[1].n_holes == 1 && trimmed_parts(m) == 3, "the top face and the 143s trimmed");
+        /* a 143 whose hole is listed first: the triangle is the outer loop; the rectangle
+         * that is its plane's border leaves no outer loop, the circle a hole */
+        CHECK(m->parts[6].has_outer && m->parts[6].n_holes == 1, "triangle around a hole");
+        CHECK(!m->parts[7].has_outer && m->parts[7].n_holes == 1, "border around a hole");
         sem_part_measure_result total;
         CHECK(sem_model_measure(m, NULL, &total, NULL) == SEM_OK, "measure");
-        const double hi[3] = {4, 3, 2};
+        const double hi[3] = {6, 6, 7};
         for (int d = 0; d < 3; ++d) {
             CHECK(fabs(total.bbox_min[d]) < 1e-12, "bbox min %d: %g", d, total.bbox_min[d]);
             CHECK(fabs(total.bbox_max[d] - hi[d]) < 1e-12, "bbox max %d: %g", d, total.bbox_max[d]);

@@ -2190,6 +2190,19 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     return st;
 }
 
+/* The box of a (u,v) loop's control points: u0, u1, v0, v1 (it holds the loop's curves). */
+static void loop_box(const curve_list *l, double box[4])
+{
+    box[0] = box[2] = INFINITY;
+    box[1] = box[3] = -INFINITY;
+    for (int i = 0; i < l->n; ++i)
+        for (int j = 0; j < l->c[i].n_ctrl; ++j) {
+            const double *p = l->c[i].ctrl + 3 * j;
+            box[0] = fmin(box[0], p[0]), box[1] = fmax(box[1], p[0]);
+            box[2] = fmin(box[2], p[1]), box[3] = fmax(box[3], p[1]);
+        }
+}
+
 static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, int depth)
 {
     int surf, n;
@@ -2215,20 +2228,49 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
-    curve_list l;
-    memset(&l, 0, sizeof l);
+    /* The loops first, then which one is outer: a 143 does not say (I-DEAS lists a plate's
+     * hole before its border: corpus occt_ideas_simple1_143), so the outer loop is the one
+     * whose (u,v) box holds every other loop's (the first when none does, as written), and
+     * none when a boundary is the surface's own border (the others are holes in it). */
+    curve_list *loops = calloc((size_t)(n > 0 ? n : 1), sizeof *loops);
+    if (!loops) {
+        sem_part_free(&part);
+        return nomem(r);
+    }
+    int n_loops = 0, no_outer = 0;
     for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n; ++i) {
         int b, border = 0;
-        list_free(&l);
         st = param_ptr(r, idx, 4 + i, 0, &b);
-        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, model_space, &l, &border);
-        if (st != SEM_OK || border) continue; /* border: the surface's own, nothing to trim */
-        if (i == 0)
-            set_outer(&part, &l);
-        else
-            st = add_hole(r, &part, &l);
+        if (st == SEM_OK)
+            st = boundary_loop(r, b, m, depth + 1, &part, model_space, &loops[n_loops], &border);
+        /* border: the surface's own, nothing to trim; a first boundary left out (warned):
+         * the rest are taken as holes, as written */
+        if ((st == SEM_OK && border) || (i == 0 && st != SEM_OK)) no_outer = 1;
+        if (st == SEM_OK && !border && loops[n_loops].n > 0) n_loops++;
+        else list_free(&loops[n_loops]);
     }
-    list_free(&l);
+    int outer = no_outer || n_loops == 0 ? -1 : 0;
+    for (int a = 0; outer >= 0 && a < n_loops; ++a) {
+        double box_a[4], box_b[4];
+        loop_box(&loops[a], box_a);
+        int holds_all = 1;
+        for (int b = 0; b < n_loops && holds_all; ++b) {
+            if (b == a) continue;
+            loop_box(&loops[b], box_b);
+            holds_all = box_a[0] <= box_b[0] && box_a[1] >= box_b[1] && box_a[2] <= box_b[2] &&
+                        box_a[3] >= box_b[3];
+        }
+        if (holds_all) {
+            outer = a;
+            break;
+        }
+    }
+    if (outer >= 0) set_outer(&part, &loops[outer]);
+    for (int a = 0; a < n_loops; ++a) {
+        if (a != outer && (st == SEM_OK || st == SEM_ERR_UNSUPPORTED)) st = add_hole(r, &part, &loops[a]);
+        list_free(&loops[a]);
+    }
+    free(loops);
     if (st != SEM_OK && st != SEM_ERR_UNSUPPORTED) {
         sem_part_free(&part);
         return st;

@@ -537,7 +537,8 @@ def file_unbounded_planes():
     and drawn at a point far from the face, trimmed by a 142 with model-space curves only
     (BPTR = 0, PREF 2). The top face has a hole of radius 0.5 around (2, 1.5) (a 100 arc
     at ZT = 2). The display size must not bound the plane: areas 12, 12 - pi / 4, 6, 6,
-    8, 8 (the corpus files occt_cone_catia and occt_cylinder_catia lost their caps)."""
+    8, 8 (the corpus files occt_cone_catia and occt_cylinder_catia lost their caps).
+    Then two 143 bounded surfaces whose hole comes first (below)."""
     sub = "00010000"
     E = []
 
@@ -566,6 +567,27 @@ def file_unbounded_planes():
             inner = add(Ent(142, ["0", de(plane), "0", de(hole), "2"], status=sub))
             params = [de(plane), "1", "1", de(outer), de(inner)]
         E[t144] = Ent(144, params)
+    # two 143s (141 TYPE 0, model space) on unbounded planes that list the hole before the
+    # outer boundary, as I-DEAS does (corpus occt_ideas_simple1_143): a triangle (0,0)-(6,0)-
+    # (0,6) at z = 5 around a hole of radius 1 at (1.5, 1.5): 18 - pi; the rectangle
+    # [0,4] x [0,3] at z = 7 (the fitted plane's own border) around a hole of radius 0.5 at
+    # (2, 1.5): 12 - pi / 4
+    for z, corners, centre, radius in ((5.0, [(0, 0), (6, 0), (0, 6)], (1.5, 1.5), 1.0),
+                                       (7.0, [(0, 0), (4, 0), (4, 3), (0, 3)], (2.0, 1.5), 0.5)):
+        t143 = add(None)
+        plane = add(Ent(108, ["0.0", "0.0", "1.0", r(z), "0", "-20.0", "30.0", r(z), "1.0"],
+                        status=sub))
+        hole = add(Ent(100, [r(z), r(centre[0]), r(centre[1]), r(centre[0] + radius),
+                             r(centre[1]), r(centre[0] + radius), r(centre[1])], status=sub))
+        h141 = add(Ent(141, ["0", "0", de(plane), "1", de(hole), "1", "0"], status=sub))
+        pts = [(x, y, z) for x, y in corners]
+        lines = [add(Ent(110, line(pts[i], pts[(i + 1) % len(pts)]), status=sub))
+                 for i in range(len(pts))]
+        outer = ["0", "0", de(plane), str(len(lines))]
+        for ln in lines:
+            outer += [de(ln), "1", "0"]
+        o141 = add(Ent(141, outer, status=sub))
+        E[t143] = Ent(143, ["0", de(plane), "2", de(h141), de(o141)])
     save("iges_unbounded_planes.igs", build(E, unit_flag=2, unit_name="MM"))
 
 
