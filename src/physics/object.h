@@ -20,7 +20,7 @@
  *   assembly.c       the shared basis, point lists, z-space work, K_blocks,
  *                    elastic_energy, qc
  *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
- *                    n_orphans
+ *                    n_orphans, part_tied
  *   system_layout.c  free_index, n_free, system
  *   newton.c         exact_hessian (during a solve)
  */
@@ -84,6 +84,7 @@ typedef struct sem_object {
     double *me_M, *me_E;
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
+    int *part_tied;            /* per part: how many of its control points are tied */
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
     double gamma;

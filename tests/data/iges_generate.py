@@ -591,6 +591,43 @@ def file_unbounded_planes():
     save("iges_unbounded_planes.igs", build(E, unit_flag=2, unit_name="MM"))
 
 
+def file_unseen_points():
+    """Control points that no boundary sample sees (tests/test_unseen_points.c). A unit cube
+    of six bicubic patches (6 x 6 control points, 3 x 3 knot spans, control points at the
+    Greville abscissae: exact planes), and on its top face two more patches:
+    part 6: the top face again, trimmed (144, (u,v) circle) to a disc of radius 0.02 around
+            the middle of its middle span: the few samples inside see the 16 basis functions
+            of that span, but cannot tell them apart, and see none of the other 20;
+    part 7: the top face again, untrimmed, with the parameter range [0, 1/3] of its knots
+            [0, 1]: control points 4 and 5 of each row are supported outside it.
+    Before, either made the sample matrix singular ("a free control point is seen by no
+    boundary sample") or left zero-energy modes."""
+    knots = [0, 0, 0, 0, 1 / 3, 2 / 3, 1, 1, 1, 1]
+    greville = [sum(knots[i + 1:i + 4]) / 3 for i in range(6)]
+
+    def face(o, a, b, rng=None):
+        grid = [[tuple(o[d] + greville[i] * a[d] + greville[j] * b[d] for d in range(3))
+                 for i in range(6)] for j in range(6)]
+        return nurbs_surface(3, 3, knots, knots, grid, rng=rng)
+
+    cube = [((0, 0, 0), (0, 1, 0), (1, 0, 0)), ((0, 0, 1), (1, 0, 0), (0, 1, 0)),
+            ((0, 0, 0), (1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1), (1, 0, 0)),
+            ((0, 0, 0), (0, 0, 1), (0, 1, 0)), ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+    sub = "00010000"
+    E = [Ent(128, face(o, a, b)) for o, a, b in cube]
+    t144 = len(E)
+    E.append(None)
+    srf = len(E)
+    E.append(Ent(128, face((0, 0, 1), (1, 0, 0), (0, 1, 0)), status=sub))
+    circle = len(E)
+    E.append(Ent(100, ["0.0", "0.5", "0.5", "0.52", "0.5", "0.52", "0.5"], status=sub))
+    loop = len(E)
+    E.append(Ent(142, ["1", de(srf), de(circle), "0", "1"], status=sub))
+    E[t144] = Ent(144, [de(srf), "1", "0", de(loop)])
+    E.append(Ent(128, face((0, 0, 1), (1, 0, 0), (0, 1, 0), rng=(0, 1 / 3, 0, 1))))
+    save("iges_unseen_points.igs", build(E))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -662,4 +699,5 @@ if __name__ == "__main__":
     file_model_space("iges_model_space_near.igs", 1e-4)
     file_analytic()
     file_unbounded_planes()
+    file_unseen_points()
     errors()
