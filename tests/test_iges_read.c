@@ -543,6 +543,40 @@ static void test_unbounded_planes(void)
     sem_model_destroy(m);
 }
 
+/* Defects Open CASCADE reads past (tests/data/iges_generate.py, file_repairs; each seen in a
+ * public file of the corpus): a unit flag of 0 with no unit name, a surface range written in
+ * the wrong order, trim curves whose range is 0, 0, and a parameter line count that runs past
+ * the Parameter section. Each is repaired with one warning; the file was refused before. */
+static void test_repairs(void)
+{
+    sem_model *m = load_data("iges_repairs.igs");
+    if (!m) return;
+    CHECK(strcmp(m->units, "IN") == 0 && m->unit_to_meter == 0.0254, "units %s", m->units);
+    CHECK(m->n_parts == 2, "parts %d", m->n_parts);
+    CHECK(m->n_warnings == 7, "warnings %d", m->n_warnings);
+    CHECK(has_warning(m, "unit flag (parameter 14) '0' is not 1..11"), "unit flag warning");
+    CHECK(has_warning(m, "entity 128 (DE 3): parameter range [0,0] x [2,1] is empty or outside "
+                         "the knots; the knots' range [0,2] x [0,1] is used"),
+          "surface range warning");
+    CHECK(has_warning(m, "entity 126 (DE 15): parameter range [0, 0] is empty; the knots' range "
+                         "[-1, 0] is used"),
+          "curve range warning");
+    CHECK(has_warning(m, "entity 128 (DE 17): parameter line count 40 runs past the Parameter "
+                         "section; its 3 lines that point back to it are read"),
+          "line count warning");
+    if (m->n_parts == 2) {
+        sem_part_measure_result r0, r1;
+        CHECK(sem_part_measure(&m->parts[0], &r0, NULL) == SEM_OK, "measure");
+        CHECK(sem_part_measure(&m->parts[1], &r1, NULL) == SEM_OK, "measure");
+        CHECK(fabs(r0.area - 0.5) < 1e-12 && fabs(r1.area - 1) < 1e-12, "areas %.12g %.12g",
+              r0.area, r1.area);
+        CHECK(m->parts[0].surface.u0 == 0 && m->parts[0].surface.u1 == 2 &&
+                  m->parts[0].surface.v0 == 0 && m->parts[0].surface.v1 == 1,
+              "range of part 0");
+    }
+    sem_model_destroy(m);
+}
+
 /* unknown geometric entity: a warning naming it; colour/property/note entities: silence */
 static void test_unknown_entity_warning(void)
 {
@@ -710,6 +744,7 @@ int main(void)
     test_model_space_trims();
     test_analytic_surfaces();
     test_unbounded_planes();
+    test_repairs();
     test_unknown_entity_warning();
     test_cad_trimmed();
     test_missing_bptr();

@@ -95,6 +95,8 @@ typedef struct iges_entry {
     unsigned char in_definition; /* member of a 308 subfigure definition */
     unsigned char busy;        /* recursion guard (stops cycles, not repeated sharing) */
     unsigned char self_ref;    /* points to itself: skipped with a warning */
+    unsigned char repaired;    /* a repair was warned about (once per entity, however often
+                                  it is used) */
 } iges_entry;
 
 typedef struct curve_list {
@@ -512,17 +514,21 @@ static sem_status read_global(iges_reader *r)
         st = tokenize(r, g, pos, glen, gline_of, "Global section", &end);
         if (st != SEM_OK) goto done;
         /* parameter k (from 1) is token first + k - 3 */
-        int unit_flag = 1;
+        int unit_flag = 1, bad_flag = 0;
         double v;
         size_t k14 = first + 11, k15 = first + 12;
         if (k14 < r->n_tokens) {
             const iges_token *t = &r->tokens[k14];
             int ok = parse_real(g + t->offset, t->length, 1.0, &v);
             if (ok != 1 || v != floor(v) || v < 1 || v > 11) {
-                st = parse_error(r, gline_of(r, t->offset),
-                                 "Global section: unit flag (parameter 14) '%.*s' is not 1..11",
-                                 t->length, g + t->offset);
-                goto done;
+                /* Rhino 1998 wrote 0 (corpus occt_rhino_bad_header); Open CASCADE reads such
+                 * a file, and so do we: the unit name decides (flag 3), else the default */
+                sem_model_warn(r->model, "Global section: unit flag (parameter 14) '%.*s' is not "
+                                         "1..11; the unit name decides, else inches (the IGES "
+                                         "default)",
+                               t->length < 20 ? t->length : 20, g + t->offset);
+                v = 3;
+                bad_flag = 1;
             }
             unit_flag = (int)v;
         }
@@ -547,7 +553,9 @@ static sem_status read_global(iges_reader *r)
                     unit_flag = alias[i].flag;
                     found = 1;
                 }
-            if (!found) {
+            if (!found && bad_flag && uname[0] == '\0') {
+                unit_flag = 1; /* no name either (an invalid flag above): the IGES default */
+            } else if (!found) {
                 sem_model_warn(r->model, "unknown unit name '%s' (unit flag 3); assuming metres",
                                uname);
                 strcpy(r->model->units, "M");
@@ -587,6 +595,21 @@ static int de_field(const iges_line *l, int f, int *out)
     if (*end != '\0') return 0;
     *out = (int)v;
     return 1;
+}
+
+/* The directory entry a Parameter line points back to (columns 66-72), or -1. */
+static int p_back_pointer(const iges_reader *r, int line)
+{
+    const iges_line *l = &r->lines[r->sec_first[SEC_P] + line];
+    if (l->len < 72) return -1;
+    char buf[8];
+    int n = 0;
+    for (int c = 65; c < 72; ++c)
+        if (l->text[c] != ' ') buf[n++] = l->text[c];
+    buf[n] = '\0';
+    char *end;
+    long back = strtol(buf, &end, 10);
+    return n > 0 && *end == '\0' && back > 0 && back < INT32_MAX ? (int)back : -1;
 }
 
 static sem_status read_directory(iges_reader *r)
@@ -638,6 +661,22 @@ static sem_status read_directory(iges_reader *r)
         }
         if (e->type == 0) continue; /* null entity */
         int np = r->sec_count[SEC_P];
+        if (e->pd_pointer >= 1 && e->pd_pointer <= np &&
+            (e->pd_count < 1 || e->pd_count > np - e->pd_pointer + 1) &&
+            p_back_pointer(r, e->pd_pointer - 1) == de_number(i)) {
+            /* a line count that runs past the Parameter section (Rhino 1998 wrote 20 for a
+             * 7-line surface: corpus occt_rhino_bad_header): the lines that point back to
+             * this entry are its lines, as Open CASCADE reads them */
+            int count = 0;
+            while (e->pd_pointer - 1 + count < np &&
+                   p_back_pointer(r, e->pd_pointer - 1 + count) == de_number(i))
+                ++count;
+            sem_model_warn(r->model, "entity %d (DE %d): parameter line count %d runs past the "
+                                     "Parameter section; its %d lines that point back to it are "
+                                     "read",
+                           e->type, de_number(i), e->pd_count, count);
+            e->pd_count = count;
+        }
         if (e->pd_pointer < 1 || e->pd_pointer > np || e->pd_count < 1 ||
             e->pd_count > np - e->pd_pointer + 1)
             return parse_error(r, l1->number,
@@ -1191,6 +1230,18 @@ static sem_status read_nurbs_curve(iges_reader *r, int idx, sem_curve *c)
     for (long long i = 0; st == SEM_OK && i < 3 * n; ++i) st = param_real(r, idx, k++, &c->ctrl[i]);
     if (st == SEM_OK) st = param_real(r, idx, k++, &c->t0);
     if (st == SEM_OK) st = param_real(r, idx, k++, &c->t1);
+    double ka = st == SEM_OK ? c->knots[M] : 0, kb = st == SEM_OK ? c->knots[K + 1] : 0;
+    if (st == SEM_OK && !(c->t1 > c->t0) && kb > ka) {
+        /* an empty range (Solid Edge writes V0 = V1 = 0: corpus occt_solidedge_deflector) is
+         * the knots' own, as Open CASCADE reads it */
+        if (!r->entries[idx].repaired)
+            sem_model_warn(r->model, "entity 126 (DE %d): parameter range [%g, %g] is empty; the "
+                                     "knots' range [%g, %g] is used",
+                           de_number(idx), c->t0, c->t1, ka, kb);
+        r->entries[idx].repaired = 1;
+        c->t0 = ka;
+        c->t1 = kb;
+    }
     if (st == SEM_OK) st = curve_validate(r, idx, c);
     if (st != SEM_OK) {
         sem_curve_free(c);
@@ -1407,6 +1458,21 @@ static sem_status read_nurbs_surface(iges_reader *r, int idx, sem_surface *s)
     if (st != SEM_OK) {
         sem_surface_free(s);
         return st;
+    }
+    /* A range that is empty or leaves the knots (Rhino 2001 wrote U0 V0 U1 V1 in the wrong
+     * order: corpus occt_rhino_bounded_143) is the knots' own, as Open CASCADE reads it. */
+    double ua = s->knots_u[M1], ub = s->knots_u[n1], va = s->knots_v[M2], vb = s->knots_v[n2];
+    double tu = 1e-9 * (ub - ua), tv = 1e-9 * (vb - va);
+    if (ub > ua && vb > va &&
+        (!(s->u1 > s->u0) || !(s->v1 > s->v0) || s->u0 < ua - tu || s->u1 > ub + tu ||
+         s->v0 < va - tv || s->v1 > vb + tv)) {
+        if (!r->entries[idx].repaired)
+            sem_model_warn(r->model, "entity 128 (DE %d): parameter range [%g,%g] x [%g,%g] is "
+                                     "empty or outside the knots; the knots' range [%g,%g] x "
+                                     "[%g,%g] is used",
+                           de_number(idx), s->u0, s->u1, s->v0, s->v1, ua, ub, va, vb);
+        r->entries[idx].repaired = 1;
+        s->u0 = ua, s->u1 = ub, s->v0 = va, s->v1 = vb;
     }
     r->entries[idx].n_used = k;
     return SEM_OK;

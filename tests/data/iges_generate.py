@@ -22,7 +22,7 @@ def holl(s):
 
 class Ent:
     def __init__(self, type_, params, form=0, xform=0, status="00000000", label="",
-                 subscript=0, color=0):
+                 subscript=0, color=0, pd_count=None):
         self.type = type_
         self.params = params  # list of str, or callables of the DE map
         self.form = form
@@ -31,6 +31,7 @@ class Ent:
         self.label = label
         self.subscript = subscript
         self.color = color
+        self.pd_count = pd_count  # a wrong parameter line count to write (repair tests)
 
 
 def de(i):
@@ -90,7 +91,8 @@ def build(entities, unit_flag=6, unit_name="M", pd=",", rd=";", start="sem test 
     for i, e in enumerate(entities):
         d1 = "%8d%8d%8d%8d%8d%8d%8d%8d%8s" % (e.type, starts[i], 0, 0, 0, 0, e.xform, 0,
                                              e.status)
-        d2 = "%8d%8d%8d%8d%8d%8s%8s%8s%8d" % (e.type, 0, e.color, counts[i], e.form, "", "",
+        count = counts[i] if e.pd_count is None else e.pd_count
+        d2 = "%8d%8d%8d%8d%8d%8s%8s%8s%8d" % (e.type, 0, e.color, count, e.form, "", "",
                                              e.label, e.subscript)
         line(d1, "D", 2 * i + 1)
         line(d2, "D", 2 * i + 2)
@@ -628,6 +630,31 @@ def file_unseen_points():
     save("iges_unseen_points.igs", build(E))
 
 
+def file_repairs():
+    """Defects Open CASCADE reads past, each repaired with a warning (corpus files in
+    brackets): unit flag 0 and no unit name [occt_rhino_bad_header] (inches, the IGES
+    default); a patch [0,2] x [0,1] whose range is written U0 V0 U1 V1
+    [occt_rhino_bounded_143] (the knots' range); its 144 loop of four 126 lines whose range
+    is written 0, 0 [occt_solidedge_deflector] (the knots' range, [-1, 0]); and a last
+    entity whose parameter line count runs past the Parameter section
+    [occt_rhino_bad_header] (the lines that point back to it). Areas 0.5 (the loop
+    [0.5, 1.5] x [0.25, 0.75]) and 1."""
+    sub = "00010000"
+    srf = nurbs_surface(1, 1, [0, 0, 2, 2], [0, 0, 1, 1],
+                        [[(0, 0, 0), (2, 0, 0)], [(0, 1, 0), (2, 1, 0)]])
+    srf[-4:] = ["0.0", "0.0", "2.0", "1.0"]  # U0 V0 U1 V1: read as [0, 0] x [2, 1], empty
+    E = [Ent(144, [de(1), "1", "0", de(2)]), Ent(128, srf, status=sub),
+         Ent(142, ["1", de(1), de(3), "0", "1"], status=sub),
+         Ent(102, ["4", de(4), de(5), de(6), de(7)], status=sub)]
+    # the loop [0.5, 1.5] x [0.25, 0.75] in (u,v): 126 lines on knots [-1, -1, 0, 0]
+    pts = [(0.5, 0.25, 0), (1.5, 0.25, 0), (1.5, 0.75, 0), (0.5, 0.75, 0)]
+    for k in range(4):
+        c = nurbs_curve(1, [-1, -1, 0, 0], [pts[k], pts[(k + 1) % 4]], t0=0.0, t1=0.0)
+        E.append(Ent(126, c[:-3], status=sub))  # no normal, as Solid Edge writes it
+    E.append(Ent(128, patch(0, 0, 1, 1, 1), pd_count=40))
+    save("iges_repairs.igs", build(E, unit_flag=0, unit_name=""))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -700,4 +727,5 @@ if __name__ == "__main__":
     file_analytic()
     file_unbounded_planes()
     file_unseen_points()
+    file_repairs()
     errors()
