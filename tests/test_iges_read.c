@@ -577,6 +577,40 @@ static void test_repairs(void)
     sem_model_destroy(m);
 }
 
+/* Loops on closed surfaces and loops with gaps (tests/data/iges_generate.py, file_seams):
+ * a (u,v) loop across a cylinder's seam (the seam is moved, exactly), a sphere cap whose loop
+ * leaves out its edge along the pole (a connector there), a 120 cylinder whose (u,v) loop is
+ * in angles (the model-space curves are taken), a 122 trimmed in IGES's u in [0, 1], a
+ * model-space loop across the seam (unwrapped), and a model-space loop with a gap of 1e-4
+ * (bridged, warned). Every area against its closed form; Open CASCADE reads the same
+ * (tests/occt_check.cpp, reference). */
+static void test_seams(void)
+{
+    sem_model *m = load_data("iges_seams.igs");
+    if (!m) return;
+    CHECK(m->n_parts == 6, "parts %d", m->n_parts);
+    CHECK(m->n_warnings == 1 && has_warning(m, "entity 142 (DE 109): a gap of 0.0001 between "
+                                               "boundary curves is bridged"),
+          "warnings %d: %s", m->n_warnings, m->n_warnings ? m->warnings[0] : "");
+    if (m->n_parts == 6) {
+        const double expected[6] = {M_PI, 2 * M_PI * (1 - sqrt(0.5)), 1, 3, M_PI / 2, 0.25};
+        const double tolerance[6] = {1e-8, 1e-8, 1e-8, 1e-12, 1e-6, 1e-6};
+        for (int i = 0; i < 6; ++i) {
+            sem_part_measure_result r;
+            CHECK(sem_part_measure(&m->parts[i], &r, NULL) == SEM_OK, "measure part %d", i);
+            CHECK(fabs(r.area - expected[i]) < tolerance[i] * expected[i],
+                  "part %d area %.12g, expected %.12g", i, r.area, expected[i]);
+            CHECK(m->parts[i].has_outer, "part %d trimmed", i);
+        }
+        /* the cylinder's domain now starts where no loop is: the loop lies inside it */
+        const sem_surface *s = &m->parts[0].surface;
+        CHECK(s->u1 - s->u0 == 1.0 && s->u0 != 0.0, "part 0 domain [%g, %g]", s->u0, s->u1);
+        /* the cap: three curves and the connector along the pole */
+        CHECK(m->parts[1].outer.n_curves == 4, "part 1 curves %d", m->parts[1].outer.n_curves);
+    }
+    sem_model_destroy(m);
+}
+
 /* unknown geometric entity: a warning naming it; colour/property/note entities: silence */
 static void test_unknown_entity_warning(void)
 {
@@ -680,7 +714,17 @@ static void test_errors(void)
     expect_parse_error("iges_err_negative_weight.igs", "weights must be positive");
     expect_parse_error("iges_err_knots.igs", "knots decrease");
     expect_parse_error("iges_err_degree.igs", "too high");
-    expect_parse_error("iges_err_open_loop.igs", "does not close");
+    /* a loop that does not close (a gap of 0.25 on a unit patch, far beyond what is bridged)
+     * is left out with a warning, as Open CASCADE keeps the face: no longer a parse error */
+    m = load_data("iges_err_open_loop.igs");
+    if (m) {
+        CHECK(m->n_parts == 1 && !m->parts[0].has_outer && m->n_warnings == 1 &&
+                  has_warning(m, "entity 144 (DE 1): the outer trim loop does not close (a gap "
+                                 "wider than 0.000141); that loop is left out"),
+              "open loop: parts %d, warnings %d: %s", m->n_parts, m->n_warnings,
+              m->n_warnings ? m->warnings[0] : "");
+        sem_model_destroy(m);
+    }
     expect_parse_error("iges_err_xform_cycle.igs", "cyclic");
     expect_parse_error("iges_err_hollerith.igs", "entity 406 (DE 17)");
 
@@ -745,6 +789,7 @@ int main(void)
     test_analytic_surfaces();
     test_unbounded_planes();
     test_repairs();
+    test_seams();
     test_unknown_entity_warning();
     test_cad_trimmed();
     test_missing_bptr();

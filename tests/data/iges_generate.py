@@ -122,11 +122,12 @@ def nurbs_curve(degree, knots, ctrl, weights=None, t0=None, t1=None, fmt=r):
     return p
 
 
-def nurbs_surface(du, dv, ku, kv, grid, weights=None, fmt=r, rng=None):
-    """grid[j][i] = point (i along u fastest, as IGES stores)."""
+def nurbs_surface(du, dv, ku, kv, grid, weights=None, fmt=r, rng=None, closed=(0, 0)):
+    """grid[j][i] = point (i along u fastest, as IGES stores); closed: PROP1, PROP2."""
     nu, nv = len(grid[0]), len(grid)
     weights = weights or [1.0] * (nu * nv)
-    p = [nu - 1, nv - 1, du, dv, 0, 0, 1 if all(w == 1 for w in weights) else 0, 0, 0]
+    p = [nu - 1, nv - 1, du, dv, closed[0], closed[1], 1 if all(w == 1 for w in weights) else 0,
+         0, 0]
     p += [fmt(k) for k in ku] + [fmt(k) for k in kv] + [fmt(w) for w in weights]
     for row in grid:
         for c in row:
@@ -655,6 +656,103 @@ def file_repairs():
     save("iges_repairs.igs", build(E, unit_flag=0, unit_name=""))
 
 
+def file_seams():
+    """Trim loops on closed surfaces and loops with gaps (issue 29, item 2), each with a closed
+    form for its area:
+    part 0: the cylinder of radius 1, z 0..2 (closed in u, seam at (1, 0)), trimmed in (u,v)
+            by the rectangle u in [-0.25, 0.25], v in [0.25, 0.75]: it crosses the seam (as
+            corpus occt_torus_periodic's loop does): half the circumference, height 1: pi
+    part 1: the unit sphere, trimmed in (u,v) to the cap above latitude 45 degrees (v = 0.75):
+            the latitude, the seam meridian up, down again, without the edge along the pole
+            (SolidWorks and Solid Edge leave it out: corpus occt_solidworks_tube): 2 pi (1 -
+            sqrt(1/2))
+    part 2: a 120 cylinder (radius 1, axis z, line generatrix z 0..2, angles 0..2 pi) trimmed
+            by a 142 with both curves: in (u,v) the rectangle u in [0.25, 0.75] (the line's
+            parameter), v in [0.3, 1.3] (angles), in model space the same: the angle is not
+            the parameter of our rational circle, so the model-space curves are taken: 1
+    part 3: a 122 tabulated cylinder over a polyline of length 3 on [0, 3], extruded by 2,
+            trimmed in (u,v) by [0, 1] x [0, 0.5]: IGES's u runs over [0, 1] (corpus
+            dealii_side_inch): 3
+    part 4: the cylinder of part 0 trimmed by a model-space loop only, crossing the seam:
+            arcs at z 0.5 and 1.5 between -45 and 45 degrees, lines between them: pi / 2
+    part 5: the unit square plate trimmed by a model-space square [0.25, 0.75]^2 whose last
+            side stops 1e-4 short (more than the projection's tolerance, within 1e-4 of the
+            surface's size, sqrt 2): bridged with a warning: 0.25
+    (The closed surfaces say so, PROP1 = 1, as CAD files write them.)"""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    def lines_uv(pts):
+        return [add(Ent(110, line(pts[k], pts[(k + 1) % len(pts)]), status=sub))
+                for k in range(len(pts))]
+
+    def trimmed(srf, bptr_curves=None, cptr_curves=None, pref=1):
+        t = add(None)
+        b = add(Ent(102, [str(len(bptr_curves))] + [de(c) for c in bptr_curves], status=sub)) \
+            if bptr_curves else None
+        c = add(Ent(102, [str(len(cptr_curves))] + [de(x) for x in cptr_curves], status=sub)) \
+            if cptr_curves else None
+        loop = add(Ent(142, ["1" if b is not None else "0", de(srf), de(b) if b is not None else "0",
+                             de(c) if c is not None else "0", str(pref)], status=sub))
+        E[t] = Ent(144, [de(srf), "1", "0", de(loop)])
+
+    cylinder = nurbs_surface(2, 1, CIRCLE_KNOTS, [0, 0, 1, 1],
+                             [[(x, y, 0) for x, y in CIRCLE_XY], [(x, y, 2) for x, y in CIRCLE_XY]],
+                             CIRCLE_W * 2, closed=(1, 0))
+    # part 0
+    s0 = add(Ent(128, cylinder, status=sub))
+    trimmed(s0, lines_uv([(-0.25, 0.25, 0), (0.25, 0.25, 0), (0.25, 0.75, 0), (-0.25, 0.75, 0)]))
+    # part 1
+    merid = [(0, -1, 1), (1, -1, math.sqrt(0.5)), (1, 0, 1), (1, 1, math.sqrt(0.5)), (0, 1, 1)]
+    s1 = add(Ent(128, nurbs_surface(2, 2, CIRCLE_KNOTS, [0, 0, 0, 0.5, 0.5, 1, 1, 1],
+                                    [[(rho * x, rho * y, z) for x, y in CIRCLE_XY]
+                                     for rho, z, _ in merid],
+                                    [wu * wv for _, _, wv in merid for wu in CIRCLE_W],
+                                    closed=(1, 0)), status=sub))
+    cap = [add(Ent(110, line(p, q), status=sub)) for p, q in
+           [((0, 0.75, 0), (1, 0.75, 0)), ((1, 0.75, 0), (1, 1, 0)), ((0, 1, 0), (0, 0.75, 0))]]
+    trimmed(s1, cap)
+    # part 2
+    axis = add(Ent(110, line((0, 0, 0), (0, 0, 1)), status=sub))
+    gen = add(Ent(110, line((1, 0, 0), (1, 0, 2)), status=sub))
+    s2 = add(Ent(120, [de(axis), de(gen), "0.0", r(2 * math.pi)], status=sub))
+    a0, a1 = 0.3, 1.3
+    uv = lines_uv([(0.25, a0, 0), (0.75, a0, 0), (0.75, a1, 0), (0.25, a1, 0)])
+    ms = [add(Ent(100, [r(0.5), "0.0", "0.0", r(math.cos(a0)), r(math.sin(a0)), r(math.cos(a1)),
+                        r(math.sin(a1))], status=sub)),
+          add(Ent(110, line((math.cos(a1), math.sin(a1), 0.5), (math.cos(a1), math.sin(a1), 1.5)),
+                  status=sub)),
+          add(Ent(100, [r(1.5), "0.0", "0.0", r(math.cos(a0)), r(math.sin(a0)), r(math.cos(a1)),
+                        r(math.sin(a1))], status=sub)),
+          add(Ent(110, line((math.cos(a0), math.sin(a0), 1.5), (math.cos(a0), math.sin(a0), 0.5)),
+                  status=sub))]
+    trimmed(s2, uv, ms)
+    # part 3
+    poly = add(Ent(126, nurbs_curve(1, [0, 0, 1, 2, 3, 3], [(0, 0, 0), (1, 0, 0), (1, 1, 0),
+                                                          (0, 1, 0)]), status=sub))
+    s3 = add(Ent(122, [de(poly), "0.0", "0.0", "2.0"], status=sub))
+    trimmed(s3, lines_uv([(0, 0, 0), (1, 0, 0), (1, 0.5, 0), (0, 0.5, 0)]))
+    # part 4
+    s4 = add(Ent(128, cylinder, status=sub))
+    c45 = math.sqrt(0.5)
+    ms = [add(Ent(100, [r(0.5), "0.0", "0.0", r(c45), r(-c45), r(c45), r(c45)], status=sub)),
+          add(Ent(110, line((c45, c45, 0.5), (c45, c45, 1.5)), status=sub)),
+          add(Ent(100, [r(1.5), "0.0", "0.0", r(c45), r(-c45), r(c45), r(c45)], status=sub)),
+          add(Ent(110, line((c45, -c45, 1.5), (c45, -c45, 0.5)), status=sub))]
+    trimmed(s4, None, ms, pref=2)
+    # part 5
+    s5 = add(Ent(128, patch(0, 0, 0, 1, 1), status=sub))
+    sq = [(0.25, 0.25, 0), (0.75, 0.25, 0), (0.75, 0.75, 0), (0.25, 0.75, 0)]
+    ms = [add(Ent(110, line(sq[k], sq[(k + 1) % 4] if k < 3 else (0.25, 0.25 + 1e-4, 0)),
+                  status=sub)) for k in range(4)]
+    trimmed(s5, None, ms, pref=2)
+    save("iges_seams.igs", build(E))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -728,4 +826,5 @@ if __name__ == "__main__":
     file_unbounded_planes()
     file_unseen_points()
     file_repairs()
+    file_seams()
     errors()
