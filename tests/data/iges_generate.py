@@ -753,6 +753,32 @@ def file_seams():
     save("iges_seams.igs", build(E))
 
 
+def file_cone_apex():
+    """A cone as CATIA writes it (corpus occt_cone_catia): a 120 surface of revolution of the
+    line from (60, 0, -70) to the apex (0, 0, 80) about the z axis, closed by an unbounded 108
+    plane z = -70 trimmed to the disc of radius 60 (model-space circle only), millimetres. The
+    generatrix has degree 1, so the cone's Lobatto points lie on its base circle and at its
+    apex, where the area element vanishes: weighted by area the group's samples are flat
+    (tests/test_unseen_points.c: the fit must still be exact, and the model simulated)."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    axis = add(Ent(110, line((0, 0, 0), (0, 0, 1)), status=sub))
+    gen = add(Ent(110, line((60, 0, -70), (0, 0, 80)), status=sub))
+    add(Ent(120, [de(axis), de(gen), "0.0", r(2 * math.pi)]))
+    t144 = add(None)
+    plane = add(Ent(108, ["0.0", "0.0", "-1.0", "70.0", "0", "0.0", "0.0", "-70.0", "1.0"],
+                    status=sub))
+    circle = add(Ent(100, ["-70.0", "0.0", "0.0", "60.0", "0.0", "60.0", "0.0"], status=sub))
+    loop = add(Ent(142, ["0", de(plane), "0", de(circle), "2"], status=sub))
+    E[t144] = Ent(144, [de(plane), "1", "0", de(loop)])
+    save("iges_cone_apex.igs", build(E, unit_flag=2, unit_name="MM"))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -827,4 +853,5 @@ if __name__ == "__main__":
     file_unseen_points()
     file_repairs()
     file_seams()
+    file_cone_apex()
     errors()
