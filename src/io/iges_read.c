@@ -43,6 +43,15 @@
  * projected into the surface's (u,v) domain by closest-point inversion along each curve
  * (geometry/trim_projection.c), so those faces are trimmed as the file means; an outer loop
  * that turns out to be the domain's own border leaves the part untrimmed (nothing to trim).
+ * So are the loops of surfaces whose parameters are not the file's (inexact_param: a surface
+ * of revolution's angle), where the file gives them in model space too.
+ *
+ * What Open CASCADE reads, we read (issue 29, docs/validation.md 3d): every part's loops go
+ * through geometry/trim_fix.c before they are checked (gaps closed or bridged within the
+ * file's resolution, loops across a closed surface's seam unwrapped and the seam moved out of
+ * their way), and header or range defects that Open CASCADE reads past (a unit flag of 0, a
+ * parameter line count past the section, empty or swapped parameter ranges) are repaired with
+ * a warning instead of refusing the file.
  */
 #include <ctype.h>
 #include <errno.h>

@@ -680,8 +680,18 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
                                  path, SEM_MAX_PARTS);
         }
         sem_part part;
+        memset(&part, 0, sizeof part);
         sem_error perr;
-        sem_status st = part_from_face(TopoDS::Face(ex.Current()), index, &part, m, &perr);
+        sem_status st;
+        try {
+            st = part_from_face(TopoDS::Face(ex.Current()), index, &part, m, &perr);
+        } catch (const Standard_Failure &e) {
+            /* one face Open CASCADE cannot convert (corpus occt_abc_0_13: an empty array in
+             * its NURBS conversion) costs that face, not the file */
+            sem_part_free(&part);
+            memset(&part, 0, sizeof part);
+            st = sem_error_set(&perr, SEM_ERR_UNSUPPORTED, "Open CASCADE: %s", e.GetMessageString());
+        }
         if (st == SEM_OK) {
             /* loops made usable (geometry/trim_fix.h): a cylinder's band whose pcurves start
              * off the converted surface's seam (corpus nist_ctc_05, chrono_assembly lost a
