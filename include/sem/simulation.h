@@ -257,6 +257,13 @@ double sem_world_object_nnz_percent(const sem_world *world, int object);
 /* Newton iterations of the last step (implicit/static). */
 int sem_world_last_iterations(const sem_world *world);
 
+/* Control points of an object that its boundary samples do not determine (supported only
+ * where a trim removed the surface, or too many for the few samples a small trim keeps):
+ * each is tied to its part's polynomial fit at its rest position (docs/simulation.md,
+ * "Robustness choices"). part_counts (the model's n_parts, may be NULL) receives how many
+ * per part. Returns the total. */
+int sem_world_object_tied_points(const sem_world *world, int object, int *part_counts);
+
 /* Zero-energy (spurious) modes of an object: motions of the free object, beyond the 6
  * rigid ones, that its rest stiffness (elastic + error energy) does not resist. values are
  * the lowest non-rigid eigenvalues of K x = lambda M x as lambda rho L^2 / E (L the

@@ -64,6 +64,26 @@ sem_status sem_surface_sampler_build_dense(const sem_surface *s, int per_span,
             sem_surface_eval(s, u, v, out->x + 3 * k, NULL, NULL, NULL);
         }
     }
+    /* closed directions: the sides meet within 1e-9 of the surface's size (an exact closed
+     * NURBS meets to round-off) at the samples along them */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < out->n; ++k)
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = fmin(lo[d], out->x[3 * k + d]);
+            hi[d] = fmax(hi[d], out->x[3 * k + d]);
+        }
+    double size = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    for (int dir = 0; dir < 2; ++dir) {
+        int n_side = dir == 0 ? gv : gu, closed = size > 0;
+        for (int j = 0; j < n_side && closed; ++j) {
+            const double *a = out->x + 3 * (dir == 0 ? (size_t)j * gu : (size_t)j);
+            const double *b = out->x + 3 * (dir == 0 ? (size_t)j * gu + gu - 1 : (size_t)(gv - 1) * gu + j);
+            double e[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+            closed = dot3(e, e) <= 1e-18 * size * size;
+        }
+        out->period[dir] = closed ? (dir == 0 ? s->u1 - s->u0 : s->v1 - s->v0) : 0;
+    }
     return SEM_OK;
 }
 
@@ -77,7 +97,15 @@ void sem_surface_sampler_free(sem_surface_sampler *sampler)
 
 static double clampd(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 
-double sem_surface_refine_closest(const sem_surface *s, const double p[3], double uv[2])
+/* t into [lo, hi] by the period (a closed direction) or by clamping */
+static double into(double t, double lo, double hi, double period)
+{
+    if (period > 0 && (t < lo || t > hi)) t -= period * floor((t - lo) / period);
+    return clampd(t, lo, hi);
+}
+
+/* Newton from uv; a step across a seam (period > 0 in that direction) wraps around. */
+static double newton(const sem_surface *s, const double period[2], const double p[3], double uv[2])
 {
     double u = clampd(uv[0], s->u0, s->u1), v = clampd(uv[1], s->v0, s->v1);
     double span_u = s->u1 - s->u0, span_v = s->v1 - s->v0;
@@ -107,8 +135,8 @@ double sem_surface_refine_closest(const sem_surface *s, const double p[3], doubl
         double nx[3], nxu[3], nxv[3], nd2[9], ndv[3];
         int accepted = 0;
         for (int ls = 0; ls < 12; ++ls, step *= 0.5) {
-            nu_ = clampd(u + step * du, s->u0, s->u1);
-            nv_ = clampd(v + step * dv, s->v0, s->v1);
+            nu_ = into(u + step * du, s->u0, s->u1, period[0]);
+            nv_ = into(v + step * dv, s->v0, s->v1, period[1]);
             sem_surface_eval(s, nu_, nv_, nx, nxu, nxv, nd2);
             for (int k = 0; k < 3; ++k) ndv[k] = nx[k] - p[k];
             nf = dot3(ndv, ndv);
@@ -118,7 +146,10 @@ double sem_surface_refine_closest(const sem_surface *s, const double p[3], doubl
             }
         }
         if (!accepted) break;
-        double moved = fabs(nu_ - u) / span_u + fabs(nv_ - v) / span_v;
+        double mu = fabs(nu_ - u), mv = fabs(nv_ - v);
+        if (period[0] > 0) mu = fmin(mu, fabs(span_u - mu)); /* across a seam */
+        if (period[1] > 0) mv = fmin(mv, fabs(span_v - mv));
+        double moved = mu / span_u + mv / span_v;
         u = nu_, v = nv_, f = nf;
         memcpy(x, nx, sizeof x), memcpy(xu, nxu, sizeof xu), memcpy(xv, nxv, sizeof xv);
         memcpy(d2, nd2, sizeof d2), memcpy(d, ndv, sizeof d);
@@ -129,6 +160,12 @@ double sem_surface_refine_closest(const sem_surface *s, const double p[3], doubl
     return sqrt(f);
 }
 
+double sem_surface_refine_closest(const sem_surface *s, const double p[3], double uv[2])
+{
+    const double open[2] = {0, 0};
+    return newton(s, open, p, uv);
+}
+
 double sem_surface_closest_point(const sem_surface_sampler *sampler, const double p[3],
                                  const double *guess, double accept, double uv[2])
 {
@@ -136,7 +173,7 @@ double sem_surface_closest_point(const sem_surface_sampler *sampler, const doubl
     double best = INFINITY, best_uv[2] = {s->u0, s->v0};
     if (guess) {
         best_uv[0] = guess[0], best_uv[1] = guess[1];
-        best = sem_surface_refine_closest(s, p, best_uv);
+        best = newton(s, sampler->period, p, best_uv);
         if (best <= accept) {
             uv[0] = best_uv[0], uv[1] = best_uv[1];
             return best;
@@ -151,6 +188,16 @@ double sem_surface_closest_point(const sem_surface_sampler *sampler, const doubl
         double e[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
         double d = dot3(e, e);
         if (d >= dist[STARTS - 1]) continue;
+        /* one start per point: the samples of a collapsed row (a pole) are one point, and
+         * starts there all stay there (x_v = 0: Newton cannot turn to the point's meridian;
+         * a surface of revolution's pole took all four starts: corpus occt_solidworks_tube) */
+        int same = 0;
+        for (int k = 0; k < STARTS && idx[k] >= 0 && !same; ++k) {
+            const double *y = sampler->x + 3 * idx[k];
+            double f[3] = {x[0] - y[0], x[1] - y[1], x[2] - y[2]};
+            same = dot3(f, f) <= 1e-24 * (dot3(x, x) + dot3(e, e));
+        }
+        if (same) continue;
         int k = STARTS - 1;
         while (k > 0 && dist[k - 1] > d) {
             dist[k] = dist[k - 1], idx[k] = idx[k - 1];
@@ -160,7 +207,7 @@ double sem_surface_closest_point(const sem_surface_sampler *sampler, const doubl
     }
     for (int k = 0; k < STARTS && idx[k] >= 0; ++k) {
         double t[2] = {sampler->uv[2 * idx[k]], sampler->uv[2 * idx[k] + 1]};
-        double d = sem_surface_refine_closest(s, p, t);
+        double d = newton(s, sampler->period, p, t);
         /* the guess wins ties: it keeps a curve on its side of a seam or pole */
         if (d < best * (1 - 1e-9) - 1e-300) {
             best = d;

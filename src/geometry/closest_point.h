@@ -19,6 +19,9 @@ typedef struct sem_surface_sampler {
     int n;          /* samples */
     double *uv;     /* 2 per sample */
     double *x;      /* 3 per sample */
+    double period[2]; /* u, v: the domain's length where the surface is closed (its two sides
+                         meet), else 0; Newton steps across such a seam come in on the other
+                         side instead of stopping at it */
 } sem_surface_sampler;
 
 sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *out,

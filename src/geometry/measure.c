@@ -7,7 +7,8 @@
  * 1e-12 relative on rational spheres and tori with one or two levels. Trimmed domains: a
  * cell that no trim-polygon edge crosses is entirely inside or outside (one inside test at
  * its centre decides); crossed cells are split until they reach a leaf size of 1/64 of
- * the domain. The error
+ * the domain and are crossed by at most LEAF_MAX_EDGES edges (a leaf with more vertices than
+ * leaf_cell takes fell back to testing Gauss points, 5e-4 off on a projected circle). The error
  * is small even there: a leaf is integrated exactly for the trim polygon (bands between
  * the polygon's vertices, trapezoids inside each band, see leaf_cell), so only the
  * polygon's departure from the trim curves and the smoothness of |x_u x x_v| remain.
@@ -30,6 +31,7 @@
 #define MAX_GAUSS 24
 #define LEAF_DIVISIONS 64.0 /* trimmed leaves: this many per domain width */
 #define MAX_TRIM_DEPTH 30
+#define LEAF_MAX_EDGES 24   /* leaves crossed by more edges are split (leaf_cell's limits) */
 #define MAX_ADAPT_DEPTH 6
 
 /* ---------------------------------------------------------------- area ---- */
@@ -221,6 +223,9 @@ static double trimmed_cell(trim_ctx *c, double u0, double u1, double v0, double 
         return gauss_cell(c->s, NULL, &c->sub_rule, u0, u1, v0, v1);
     }
     int split_u = (u1 - u0) > c->leaf_u, split_v = (v1 - v0) > c->leaf_v;
+    /* a leaf crossed by more edges than leaf_cell integrates exactly (a dense polygon: a
+     * model-space loop projected in fine steps) is split further */
+    if (!split_u && !split_v && m > LEAF_MAX_EDGES) split_u = split_v = 1;
     if ((!split_u && !split_v) || depth >= MAX_TRIM_DEPTH)
         return leaf_cell(c, u0, u1, v0, v1, mine, m);
     double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);

@@ -52,7 +52,34 @@ typedef struct context {
     int closed[2];     /* seam: S(u0, v) == S(u1, v) (u) / the same in v */
     double eps[2];     /* "on the border" in u and v */
     double worst;      /* largest distance of a curve point from the surface */
+    int unwrap;        /* the second pass: (u,v) continuous across seams (see below) */
+    double max_gap;    /* gaps between curves bridged (model units) */
+    double gap;        /* the largest gap bridged */
+    int join_failed;   /* the loop did not close in (u,v) */
 } context;
+
+/* (u,v) in the domain: in the unwrapping pass, a coordinate of a closed direction modulo the
+ * period (the loop's points leave the domain where it crosses the seam) */
+static void wrap(const context *c, const double in[2], double out[2])
+{
+    const sem_surface *s = c->s;
+    double lo[2] = {s->u0, s->v0}, hi[2] = {s->u1, s->v1};
+    for (int d = 0; d < 2; ++d) {
+        out[d] = in[d];
+        if (!c->unwrap || !c->closed[d]) continue;
+        double P = hi[d] - lo[d];
+        out[d] -= P * floor((out[d] - lo[d]) / P);
+        out[d] = fmin(fmax(out[d], lo[d]), hi[d]);
+    }
+}
+
+/* S(u,v), wrapped */
+static void surface_at(const context *c, const double uv[2], double x[3])
+{
+    double w[2];
+    wrap(c, uv, w);
+    sem_surface_eval(c->s, w[0], w[1], x, NULL, NULL, NULL);
+}
 
 static double dist3(const double *a, const double *b)
 {
@@ -87,7 +114,7 @@ static double surface_size(const sem_surface *s)
 sem_trim_projection_settings sem_default_trim_projection_settings(const sem_surface *s)
 {
     double size = surface_size(s);
-    sem_trim_projection_settings o = {2e-5 * size, 1e-2 * size};
+    sem_trim_projection_settings o = {2e-5 * size, 1e-2 * size, 1e-4 * size};
     return o;
 }
 
@@ -112,10 +139,12 @@ static int is_closed(const sem_surface *s, int dir, double tol)
 
 /* The line u = const (dir 0: x_u = 0 along it, a pole at this v) is collapsed when the
  * iso-curve in u through (u,v) has (near) zero length. */
-static int collapsed_in(const context *c, int dir, const double uv[2])
+static int collapsed_in(const context *c, int dir, const double uv_in[2])
 {
     const sem_surface *s = c->s;
-    double a[3], b[3], m[3], du[3], dv[3];
+    double a[3], b[3], m[3], du[3], dv[3], w[2];
+    wrap(c, uv_in, w);
+    const double *uv = w;
     /* cheap test first: the iso-curve cannot be collapsed where it has a tangent */
     sem_surface_eval(s, uv[0], uv[1], m, du, dv, NULL);
     const double *t = dir == 0 ? du : dv;
@@ -154,13 +183,22 @@ static int push(chain *ch, const point *p)
 static void project(context *c, const sem_curve *cv, double t, const double *guess, double near,
                     point *out)
 {
-    double X[3];
+    double X[3], g[2];
     sem_curve_eval(cv, t, X, NULL);
     out->t = t;
-    double d = sem_surface_closest_point(c->sampler, X, guess, near + 0.1 * c->tol, out->uv);
+    if (guess) wrap(c, guess, g);
+    double d = sem_surface_closest_point(c->sampler, X, guess ? g : NULL, near + 0.1 * c->tol, out->uv);
     out->d = d;
     if (d > c->worst) c->worst = d;
     sem_surface_eval(c->s, out->uv[0], out->uv[1], out->x, NULL, NULL, NULL);
+    /* unwrapping: the point's (u,v) taken the number of periods that puts it nearest the
+     * previous one, so that the loop runs on across a seam instead of jumping back */
+    if (c->unwrap && guess) {
+        const sem_surface *s = c->s;
+        double P[2] = {s->u1 - s->u0, s->v1 - s->v0};
+        for (int k = 0; k < 2; ++k)
+            if (c->closed[k]) out->uv[k] += P[k] * round((guess[k] - out->uv[k]) / P[k]);
+    }
 }
 
 /* Points of (a, b] between a and b, refined; appended to ch. */
@@ -172,7 +210,7 @@ static int refine(context *c, const sem_curve *cv, const point *a, const point *
         double mid_uv[2] = {0.5 * (a->uv[0] + b->uv[0]), 0.5 * (a->uv[1] + b->uv[1])};
         project(c, cv, 0.5 * (a->t + b->t), mid_uv, a->d > b->d ? a->d : b->d, &m);
         double chord[3];
-        sem_surface_eval(c->s, mid_uv[0], mid_uv[1], chord, NULL, NULL, NULL);
+        surface_at(c, mid_uv, chord);
         if (dist3(chord, m.x) > c->tol) {
             if (!refine(c, cv, a, &m, depth + 1, ch)) return 0;
             return refine(c, cv, &m, b, depth + 1, ch);
@@ -228,10 +266,10 @@ static int joinable(const context *c, const double a[2], const double b[2])
     double du = (b[0] - a[0]) / (s->u1 - s->u0), dv = (b[1] - a[1]) / (s->v1 - s->v0);
     if (hypot(du, dv) < 1e-9) return 1;
     double xa[3], x[3];
-    sem_surface_eval(s, a[0], a[1], xa, NULL, NULL, NULL);
+    surface_at(c, a, xa);
     for (int k = 1; k <= 8; ++k) {
-        sem_surface_eval(s, a[0] + (b[0] - a[0]) * k / 8.0, a[1] + (b[1] - a[1]) * k / 8.0, x,
-                         NULL, NULL, NULL);
+        double uv[2] = {a[0] + (b[0] - a[0]) * k / 8.0, a[1] + (b[1] - a[1]) * k / 8.0};
+        surface_at(c, uv, x);
         if (dist3(x, xa) > c->tol) return 0;
     }
     return 1;
@@ -262,7 +300,7 @@ static void fix_seams_and_poles(context *c, chain *chains, int n)
                 if (j >= 0 && !collapsed_in(c, dir, ch->p[j].uv)) ch->p[i].uv[dir] = ch->p[j].uv[dir];
             }
         }
-        if (!c->closed[dir]) continue;
+        if (!c->closed[dir] || c->unwrap) continue; /* unwrapped points need no side */
         /* a point on the seam in a curve that leaves it takes the side of the nearest
          * point of that curve off the seam */
         unsigned char *pure = calloc((size_t)n, 1);
@@ -385,42 +423,52 @@ static sem_status join(context *c, const point *a_end, point *b_start, int *need
         b_start->uv[0] = a_end->uv[0], b_start->uv[1] = a_end->uv[1];
         return SEM_OK;
     }
-    /* is the straight (u,v) segment between them a single point in space? */
+    /* is the straight (u,v) segment between them a single point in space (a collapsed
+     * edge), or, failing that, a gap between the curves' ends no wider than max_gap (the
+     * file's resolution: a connector there is within what the file itself tolerates)? */
+    double far = 0, gap = dist3(a_end->x, b_start->x);
     for (int k = 1; k < 8; ++k) {
         double uv[2] = {a_end->uv[0] + (b_start->uv[0] - a_end->uv[0]) * k / 8.0,
                         a_end->uv[1] + (b_start->uv[1] - a_end->uv[1]) * k / 8.0};
         double x[3];
-        sem_surface_eval(s, uv[0], uv[1], x, NULL, NULL, NULL);
-        if (dist3(x, a_end->x) > c->tol && dist3(x, b_start->x) > c->tol) {
-            return sem_error_set(err, SEM_ERR_INVALID,
-                                 "the loop does not close in (u,v) %s: (%.6g, %.6g) to "
-                                 "(%.6g, %.6g)%s",
-                                 where, a_end->uv[0], a_end->uv[1], b_start->uv[0],
-                                 b_start->uv[1],
-                                 c->closed[0] || c->closed[1]
-                                     ? " (it crosses the seam of a closed surface)"
-                                     : "");
-        }
+        surface_at(c, uv, x);
+        far = fmax(far, fmin(dist3(x, a_end->x), dist3(x, b_start->x)));
     }
+    if (far > c->tol && !(far <= c->max_gap && gap <= c->max_gap)) {
+        c->join_failed = 1;
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "the loop does not close in (u,v) %s: (%.6g, %.6g) to "
+                             "(%.6g, %.6g)%s",
+                             where, a_end->uv[0], a_end->uv[1], b_start->uv[0], b_start->uv[1],
+                             !c->closed[0] && !c->closed[1] ? ""
+                             : c->unwrap ? " (it winds around a closed surface)"
+                                         : " (it crosses the seam of a closed surface)");
+    }
+    if (far > c->tol) c->gap = fmax(c->gap, gap);
     *needs = 1;
     connector[0] = a_end->uv[0], connector[1] = a_end->uv[1];
     connector[2] = b_start->uv[0], connector[3] = b_start->uv[1];
     return SEM_OK;
 }
 
-sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_curve *curves,
-                                 int n_curves, const sem_trim_projection_settings *settings,
-                                 sem_trim_loop *out, int *border, sem_error *err)
+/* One pass of sem_trim_project_loop; unwrap: the second (see there). */
+static sem_status project_pass(const sem_surface_sampler *sampler, const sem_curve *curves,
+                               int n_curves, const sem_trim_projection_settings *settings,
+                               int unwrap, sem_trim_loop *out, int *border, double *gap,
+                               int *join_failed, sem_error *err)
 {
     memset(out, 0, sizeof *out);
     *border = 0;
-    if (n_curves < 1) return sem_error_set(err, SEM_ERR_INVALID, "empty trim loop");
+    *gap = 0;
+    *join_failed = 0;
     context c;
     memset(&c, 0, sizeof c);
     c.sampler = sampler;
     c.s = sampler->surface;
     c.tol = settings->tolerance;
     c.max_distance = settings->max_distance;
+    c.max_gap = settings->max_gap;
+    c.unwrap = unwrap;
     c.closed[0] = is_closed(c.s, 0, c.tol);
     c.closed[1] = is_closed(c.s, 1, c.tol);
     c.eps[0] = 1e-9 * (c.s->u1 - c.s->u0);
@@ -495,7 +543,24 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
         goto done;
     }
     fix_seams_and_poles(&c, chains, n_curves);
-    if (all_on_border(&c, chains, n_curves)) {
+    /* A curve that crosses the seam of a closed surface jumps by about a period inside its
+     * chain (the closest points are found on both sides): the loop cannot be drawn in the
+     * domain as it is; the second pass unwraps it. (A jump along a collapsed edge, over a
+     * pole, is no crossing.) */
+    for (int k = 0; !c.unwrap && (c.closed[0] || c.closed[1]) && k < n_curves; ++k)
+        for (int i = 1; i < chains[k].n; ++i) {
+            const double *a = chains[k].p[i - 1].uv, *b = chains[k].p[i].uv;
+            int jump = (c.closed[0] && fabs(b[0] - a[0]) > 0.5 * (c.s->u1 - c.s->u0)) ||
+                       (c.closed[1] && fabs(b[1] - a[1]) > 0.5 * (c.s->v1 - c.s->v0));
+            if (jump && !joinable(&c, a, b)) {
+                c.join_failed = 1;
+                st = sem_error_set(err, SEM_ERR_INVALID, "the loop does not close in (u,v): curve "
+                                                         "%d crosses the seam of a closed surface",
+                                   k + 1);
+                goto done;
+            }
+        }
+    if (!c.unwrap && all_on_border(&c, chains, n_curves)) {
         /* the domain's own border: all of it, or around a closed surface (where the loop,
          * given without the seam, cannot close in (u,v)) */
         int wraps = c.closed[0] || c.closed[1];
@@ -514,7 +579,7 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
     for (int k = 0; k < n_curves && st == SEM_OK; ++k) {
         chain *ch = &chains[k];
         chain *next = &chains[(k + 1) % n_curves];
-        double conn[4];
+        double conn[4] = {0, 0, 0, 0};
         int needs = 0;
         char where[64];
         if (k + 1 < n_curves)
@@ -545,6 +610,8 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
     }
 
 done:
+    *gap = c.gap;
+    *join_failed = c.join_failed;
     if (st != SEM_OK && out->curves) {
         for (int k = 0; k < out->n_curves; ++k) sem_curve_free(&out->curves[k]);
         free(out->curves);
@@ -554,5 +621,40 @@ done:
         for (int k = 0; k < n_curves; ++k) free(chains[k].p);
     free(chains);
     free(reverse);
+    return st;
+}
+
+sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_curve *curves,
+                                 int n_curves, const sem_trim_projection_settings *settings,
+                                 sem_trim_loop *out, int *border, double *gap, sem_error *err)
+{
+    memset(out, 0, sizeof *out);
+    *border = 0;
+    *gap = 0;
+    if (n_curves < 1) return sem_error_set(err, SEM_ERR_INVALID, "empty trim loop");
+    int join_failed = 0;
+    sem_status st = project_pass(sampler, curves, n_curves, settings, 0, out, border, gap,
+                                 &join_failed, err);
+    const sem_surface *s = sampler->surface;
+    if (st == SEM_ERR_INVALID && join_failed &&
+        (is_closed(s, 0, settings->tolerance) || is_closed(s, 1, settings->tolerance))) {
+        /* A loop that crosses the seam of a closed surface jumps by a period where it does,
+         * and cannot close in the domain: projected again, each point unwrapped to the
+         * period nearest the point before it (as Open CASCADE's shape fixing unwraps its
+         * pcurves), the loop runs on across the seam and closes outside the domain; the
+         * reader then moves the surface's seam out of its way (geometry/seam.h). The first
+         * pass stays the rule: it keeps the seam edges of B-rep faces on their sides. */
+        sem_error second;
+        int border2 = 0, failed2 = 0;
+        double gap2 = 0;
+        sem_status st2 = project_pass(sampler, curves, n_curves, settings, 1, out, &border2, &gap2,
+                                      &failed2, &second);
+        if (st2 == SEM_OK || st2 == SEM_ERR_NOMEM) {
+            st = st2;
+            *border = border2;
+            *gap = gap2;
+            if (st2 != SEM_OK && err) *err = second;
+        }
+    }
     return st;
 }

@@ -14,6 +14,8 @@ typedef struct sem_trim_projection_settings {
                             this much (model units); default 2e-5 x surface size */
     double max_distance; /* a curve point farther than this from the surface fails the loop;
                             default 1e-2 x surface size */
+    double max_gap;      /* a gap up to this between consecutive curves (model units) is
+                            bridged by a straight (u,v) connector; default 1e-4 x surface size */
 } sem_trim_projection_settings;
 
 /* Defaults for a surface: relative to the diagonal of its control points' bounding box. */
@@ -29,10 +31,14 @@ sem_trim_projection_settings sem_default_trim_projection_settings(const sem_surf
  * *border is set to 1 (and out left empty) when the loop runs along the border of the
  * domain only and encloses all of it, or wraps around a closed surface on its border (a
  * periodic surface's natural boundary given without its seam): a trim that trims nothing.
+ * A gap between consecutive curves of at most settings->max_gap is bridged by a connector;
+ * *gap receives the widest bridged (0: none), for the caller's warning. On a closed surface
+ * a loop that crosses the seam is projected again with its (u,v) unwrapped across the seam
+ * (it then leaves the domain by up to a period; geometry/seam.h moves the seam to fit).
  * Fails (SEM_ERR_INVALID, message says why) when a curve is off the surface or the loop
  * does not close in (u,v). */
 sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_curve *curves,
                                  int n_curves, const sem_trim_projection_settings *settings,
-                                 sem_trim_loop *out, int *border, sem_error *err);
+                                 sem_trim_loop *out, int *border, double *gap, sem_error *err);
 
 #endif

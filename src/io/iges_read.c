@@ -43,6 +43,15 @@
  * projected into the surface's (u,v) domain by closest-point inversion along each curve
  * (geometry/trim_projection.c), so those faces are trimmed as the file means; an outer loop
  * that turns out to be the domain's own border leaves the part untrimmed (nothing to trim).
+ * So are the loops of surfaces whose parameters are not the file's (inexact_param: a surface
+ * of revolution's angle), where the file gives them in model space too.
+ *
+ * What Open CASCADE reads, we read (issue 29, docs/validation.md 3d): every part's loops go
+ * through geometry/trim_fix.c before they are checked (gaps closed or bridged within the
+ * file's resolution, loops across a closed surface's seam unwrapped and the seam moved out of
+ * their way), and header or range defects that Open CASCADE reads past (a unit flag of 0, a
+ * parameter line count past the section, empty or swapped parameter ranges) are repaired with
+ * a warning instead of refusing the file.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -55,6 +64,7 @@
 #include <string.h>
 
 #include "geometry/analytic_surfaces.h"
+#include "geometry/trim_fix.h"
 #include "geometry/trim_projection.h"
 #include "io/read_file.h"
 #include "sem/limits.h"
@@ -96,6 +106,8 @@ typedef struct iges_entry {
     unsigned char in_definition; /* member of a 308 subfigure definition */
     unsigned char busy;        /* recursion guard (stops cycles, not repeated sharing) */
     unsigned char self_ref;    /* points to itself: skipped with a warning */
+    unsigned char repaired;    /* a repair was warned about (once per entity, however often
+                                  it is used) */
 } iges_entry;
 
 typedef struct curve_list {
@@ -127,6 +139,12 @@ typedef struct iges_reader {
     int from_hint;
     int hint_fit;
     int hint_seam; /* the surface's seam may be turned to suit the boundary */
+    /* The surface's NURBS parameters are not the file's (a surface of revolution's angle is
+     * not the parameter of our rational circle, nor an arc's angle that of its NURBS): its
+     * loops are better taken from model space when the file gives them there too. */
+    int inexact_param;
+    double resolution;        /* Global parameter 19, the file's own tolerance (model units),
+                                 or 0 */
     long long conversions;    /* entity conversions so far (SEM_MAX_IGES_EXPANSION) */
     long long built_points;   /* control points built so far (SEM_MAX_MODEL_CONTROL_POINTS) */
 } iges_reader;
@@ -513,17 +531,26 @@ static sem_status read_global(iges_reader *r)
         st = tokenize(r, g, pos, glen, gline_of, "Global section", &end);
         if (st != SEM_OK) goto done;
         /* parameter k (from 1) is token first + k - 3 */
-        int unit_flag = 1;
+        int unit_flag = 1, bad_flag = 0;
         double v;
-        size_t k14 = first + 11, k15 = first + 12;
+        size_t k14 = first + 11, k15 = first + 12, k19 = first + 16;
+        /* parameter 19: the minimum user-intended resolution, the gaps the file tolerates */
+        if (k19 < r->n_tokens && !r->tokens[k19].is_string &&
+            parse_real(g + r->tokens[k19].offset, r->tokens[k19].length, 0.0, &v) == 1 && v > 0 &&
+            isfinite(v))
+            r->resolution = v;
         if (k14 < r->n_tokens) {
             const iges_token *t = &r->tokens[k14];
             int ok = parse_real(g + t->offset, t->length, 1.0, &v);
             if (ok != 1 || v != floor(v) || v < 1 || v > 11) {
-                st = parse_error(r, gline_of(r, t->offset),
-                                 "Global section: unit flag (parameter 14) '%.*s' is not 1..11",
-                                 t->length, g + t->offset);
-                goto done;
+                /* Rhino 1998 wrote 0 (corpus occt_rhino_bad_header); Open CASCADE reads such
+                 * a file, and so do we: the unit name decides (flag 3), else the default */
+                sem_model_warn(r->model, "Global section: unit flag (parameter 14) '%.*s' is not "
+                                         "1..11; the unit name decides, else inches (the IGES "
+                                         "default)",
+                               t->length < 20 ? t->length : 20, g + t->offset);
+                v = 3;
+                bad_flag = 1;
             }
             unit_flag = (int)v;
         }
@@ -548,7 +575,9 @@ static sem_status read_global(iges_reader *r)
                     unit_flag = alias[i].flag;
                     found = 1;
                 }
-            if (!found) {
+            if (!found && bad_flag && uname[0] == '\0') {
+                unit_flag = 1; /* no name either (an invalid flag above): the IGES default */
+            } else if (!found) {
                 sem_model_warn(r->model, "unknown unit name '%s' (unit flag 3); assuming metres",
                                uname);
                 strcpy(r->model->units, "M");
@@ -588,6 +617,21 @@ static int de_field(const iges_line *l, int f, int *out)
     if (*end != '\0') return 0;
     *out = (int)v;
     return 1;
+}
+
+/* The directory entry a Parameter line points back to (columns 66-72), or -1. */
+static int p_back_pointer(const iges_reader *r, int line)
+{
+    const iges_line *l = &r->lines[r->sec_first[SEC_P] + line];
+    if (l->len < 72) return -1;
+    char buf[8];
+    int n = 0;
+    for (int c = 65; c < 72; ++c)
+        if (l->text[c] != ' ') buf[n++] = l->text[c];
+    buf[n] = '\0';
+    char *end;
+    long back = strtol(buf, &end, 10);
+    return n > 0 && *end == '\0' && back > 0 && back < INT32_MAX ? (int)back : -1;
 }
 
 static sem_status read_directory(iges_reader *r)
@@ -639,6 +683,22 @@ static sem_status read_directory(iges_reader *r)
         }
         if (e->type == 0) continue; /* null entity */
         int np = r->sec_count[SEC_P];
+        if (e->pd_pointer >= 1 && e->pd_pointer <= np &&
+            (e->pd_count < 1 || e->pd_count > np - e->pd_pointer + 1) &&
+            p_back_pointer(r, e->pd_pointer - 1) == de_number(i)) {
+            /* a line count that runs past the Parameter section (Rhino 1998 wrote 20 for a
+             * 7-line surface: corpus occt_rhino_bad_header): the lines that point back to
+             * this entry are its lines, as Open CASCADE reads them */
+            int count = 0;
+            while (e->pd_pointer - 1 + count < np &&
+                   p_back_pointer(r, e->pd_pointer - 1 + count) == de_number(i))
+                ++count;
+            sem_model_warn(r->model, "entity %d (DE %d): parameter line count %d runs past the "
+                                     "Parameter section; its %d lines that point back to it are "
+                                     "read",
+                           e->type, de_number(i), e->pd_count, count);
+            e->pd_count = count;
+        }
         if (e->pd_pointer < 1 || e->pd_pointer > np || e->pd_count < 1 ||
             e->pd_count > np - e->pd_pointer + 1)
             return parse_error(r, l1->number,
@@ -918,30 +978,8 @@ static void list_free(curve_list *l)
     memset(l, 0, sizeof *l);
 }
 
-/* Exact reversal: control points and weights in reverse order, knots t -> a + b - t. */
-static void curve_reverse(sem_curve *c)
-{
-    int n = c->n_ctrl, m = c->n_ctrl + c->degree + 1;
-    for (int i = 0, j = n - 1; i < j; ++i, --j) {
-        for (int k = 0; k < 3; ++k) {
-            double t = c->ctrl[3 * i + k];
-            c->ctrl[3 * i + k] = c->ctrl[3 * j + k];
-            c->ctrl[3 * j + k] = t;
-        }
-        double w = c->weights[i];
-        c->weights[i] = c->weights[j];
-        c->weights[j] = w;
-    }
-    double a = c->knots[0], b = c->knots[m - 1];
-    for (int i = 0, j = m - 1; i <= j; ++i, --j) {
-        double ki = c->knots[i], kj = c->knots[j];
-        c->knots[i] = a + b - kj;
-        c->knots[j] = a + b - ki;
-    }
-    double t0 = c->t0;
-    c->t0 = a + b - c->t1;
-    c->t1 = a + b - t0;
-}
+/* Exact reversal (geometry/trim_fix.c). */
+static void curve_reverse(sem_curve *c) { sem_curve_reverse(c); }
 
 /* Inserts knot t (strictly inside the knot range) `times` times, clamped so that its
  * multiplicity stays <= degree (Piegl & Tiller A5.1, in homogeneous coordinates). */
@@ -1192,6 +1230,18 @@ static sem_status read_nurbs_curve(iges_reader *r, int idx, sem_curve *c)
     for (long long i = 0; st == SEM_OK && i < 3 * n; ++i) st = param_real(r, idx, k++, &c->ctrl[i]);
     if (st == SEM_OK) st = param_real(r, idx, k++, &c->t0);
     if (st == SEM_OK) st = param_real(r, idx, k++, &c->t1);
+    double ka = st == SEM_OK ? c->knots[M] : 0, kb = st == SEM_OK ? c->knots[K + 1] : 0;
+    if (st == SEM_OK && !(c->t1 > c->t0) && kb > ka) {
+        /* an empty range (Solid Edge writes V0 = V1 = 0: corpus occt_solidedge_deflector) is
+         * the knots' own, as Open CASCADE reads it */
+        if (!r->entries[idx].repaired)
+            sem_model_warn(r->model, "entity 126 (DE %d): parameter range [%g, %g] is empty; the "
+                                     "knots' range [%g, %g] is used",
+                           de_number(idx), c->t0, c->t1, ka, kb);
+        r->entries[idx].repaired = 1;
+        c->t0 = ka;
+        c->t1 = kb;
+    }
     if (st == SEM_OK) st = curve_validate(r, idx, c);
     if (st != SEM_OK) {
         sem_curve_free(c);
@@ -1409,6 +1459,21 @@ static sem_status read_nurbs_surface(iges_reader *r, int idx, sem_surface *s)
         sem_surface_free(s);
         return st;
     }
+    /* A range that is empty or leaves the knots (Rhino 2001 wrote U0 V0 U1 V1 in the wrong
+     * order: corpus occt_rhino_bounded_143) is the knots' own, as Open CASCADE reads it. */
+    double ua = s->knots_u[M1], ub = s->knots_u[n1], va = s->knots_v[M2], vb = s->knots_v[n2];
+    double tu = 1e-9 * (ub - ua), tv = 1e-9 * (vb - va);
+    if (ub > ua && vb > va &&
+        (!(s->u1 > s->u0) || !(s->v1 > s->v0) || s->u0 < ua - tu || s->u1 > ub + tu ||
+         s->v0 < va - tv || s->v1 > vb + tv)) {
+        if (!r->entries[idx].repaired)
+            sem_model_warn(r->model, "entity 128 (DE %d): parameter range [%g,%g] x [%g,%g] is "
+                                     "empty or outside the knots; the knots' range [%g,%g] x "
+                                     "[%g,%g] is used",
+                           de_number(idx), s->u0, s->u1, s->v0, s->v1, ua, ub, va, vb);
+        r->entries[idx].repaired = 1;
+        s->u0 = ua, s->u1 = ub, s->v0 = va, s->v1 = vb;
+    }
     r->entries[idx].n_used = k;
     return SEM_OK;
 }
@@ -1428,8 +1493,10 @@ static void set_bilinear(sem_surface *s, const double o[3], const double e1[3],
 /* 108: the plane A x + B y + C z = D. A bounded plane (PTR to a closed curve) becomes the
  * bilinear patch over the bounding box of the curve's control points in an orthonormal
  * frame of the plane, trimmed by that curve mapped into the frame (an affine map, so the
- * trim curve is exact). An unbounded plane with a display SIZE becomes the square of half
- * side SIZE centred at the display point projected onto the plane. */
+ * trim curve is exact). An unbounded plane (PTR = 0) inside a trimmed entity or face with
+ * model-space boundary curves is fitted to that boundary (surface_hint); elsewhere, with a
+ * display SIZE, it becomes the square of half side SIZE centred at the display point
+ * projected onto the plane. */
 static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
 {
     double a[4], xyz[3], size;
@@ -1460,7 +1527,11 @@ static sem_status read_plane(iges_reader *r, int idx, int depth, sem_part *part)
     double o[3] = {xyz[0] - off * n[0], xyz[1] - off * n[1], xyz[2] - off * n[2]};
     if (sem_surface_alloc(&part->surface, 1, 1, 2, 2) != SEM_OK) return nomem(r);
     if (ptr < 0) {
-        if (!(size > 0) && r->surface_hint) {
+        /* An unbounded plane inside a trimmed entity or face is sized by that boundary, with
+         * or without a display size: SIZE only says how large to draw the plane's symbol
+         * (CATIA writes 1.0 whatever the face), and taking it as the extent left the
+         * boundary off the surface (occt_cone_catia, occt_cylinder_catia in the corpus). */
+        if (r->surface_hint) {
             set_bilinear(&part->surface, o, e1, e2, -1.0, 1.0, -1.0, 1.0);
             r->from_hint = 1;
             r->hint_fit = HINT_PLANE;
@@ -1642,6 +1713,7 @@ static sem_status read_revolution(iges_reader *r, int idx, int depth, sem_surfac
     s->v0 = sa;
     s->v1 = ta;
     sem_curve_free(&c);
+    r->inexact_param = 1; /* v: the angle in the file, a rational circle's parameter here */
     return SEM_OK;
 }
 
@@ -1657,6 +1729,15 @@ static sem_status read_tabulated(iges_reader *r, int idx, int depth, sem_surface
     sem_curve c;
     st = read_single_curve(r, pc, identity_xf, depth + 1, idx, &c);
     if (st != SEM_OK) return st;
+    /* IGES parameterizes a tabulated cylinder by t = t0 + u (t1 - t0), u in [0, 1]: the
+     * file's trim curves use that u (corpus dealii_side_inch: a directrix on [0, 3] trimmed
+     * in [0, 1] kept a third of the face). An affine map of the knots is exact. */
+    if (c.t0 != 0.0 || c.t1 != 1.0) {
+        double a = c.t0, b = c.t1;
+        for (int i = 0; i < c.n_ctrl + c.degree + 1; ++i) c.knots[i] = (c.knots[i] - a) / (b - a);
+        c.t0 = 0.0;
+        c.t1 = 1.0;
+    }
     double start[3];
     sem_curve_eval(&c, c.t0, start, NULL);
     double d[3] = {L[0] - start[0], L[1] - start[1], L[2] - start[2]};
@@ -1678,6 +1759,8 @@ static sem_status read_tabulated(iges_reader *r, int idx, int depth, sem_surface
     s->v0 = 0.0;
     s->v1 = 1.0;
     sem_curve_free(&c);
+    /* u: the directrix's own parameter in the file; ours for lines and B-splines only */
+    if (r->entries[pc].type != 110 && r->entries[pc].type != 126) r->inexact_param = 1;
     return SEM_OK;
 }
 
@@ -1901,6 +1984,38 @@ static int color_rgb(const iges_reader *r, int color, float rgb[3])
     return 1;
 }
 
+/* A part's trim loops made usable (geometry/trim_fix.h), with a warning for each repair that
+ * is not exact: a bridged gap, a loop left out. Nothing changes for loops that need nothing
+ * (every shared model). */
+static sem_status fix_loops(iges_reader *r, sem_part *part, int top)
+{
+    sem_loop_fix fix;
+    memset(&fix, 0, sizeof fix);
+    fix.bridge = r->resolution; /* the gaps the file allows (or 1e-4 of the surface) */
+    sem_status st = sem_part_fix_loops(part, &fix);
+    if (st != SEM_OK) return nomem(r);
+    int type = r->entries[top].type;
+    if (fix.widest_gap > 0)
+        sem_model_warn(r->model, "entity %d (DE %d): a gap of %.3g between trim curves is bridged "
+                                 "(allowed %.3g: the file's resolution or 1e-4 of the surface)",
+                       type, de_number(top), fix.widest_gap, fix.gap_limit);
+    if (fix.outer_dropped)
+        sem_model_warn(r->model, "entity %d (DE %d): the outer trim loop does not close (a gap "
+                                 "wider than %.3g); that loop is left out",
+                       type, de_number(top), fix.gap_limit);
+    if (fix.holes_dropped)
+        sem_model_warn(r->model, "entity %d (DE %d): %d hole trim loop%s not close (a gap wider "
+                                 "than %.3g); left out",
+                       type, de_number(top), fix.holes_dropped, fix.holes_dropped == 1 ? " does" : "s do",
+                       fix.gap_limit);
+    if (fix.wound)
+        sem_model_warn(r->model, "entity %d (DE %d): the trim loops wind around the closed "
+                                 "surface and cannot share one period of it; they are kept as "
+                                 "written",
+                       type, de_number(top));
+    return SEM_OK;
+}
+
 /* Names, colour and source, then the checks every part must pass, then into the model. */
 static sem_status finish_part(iges_reader *r, sem_part *part, int top, int surf)
 {
@@ -1915,6 +2030,11 @@ static sem_status finish_part(iges_reader *r, sem_part *part, int top, int surf)
         sem_part_free(part);
         return entity_error(r, top, 0, "the model would have more than %d parts (limit "
                                        "SEM_MAX_PARTS)", SEM_MAX_PARTS);
+    }
+    sem_status fs = fix_loops(r, part, top);
+    if (fs != SEM_OK) {
+        sem_part_free(part);
+        return fs;
     }
     sem_error ve;
     if (sem_part_validate_trims(part, &ve) != SEM_OK) {
@@ -1966,10 +2086,18 @@ static sem_status project_model_space_loop(iges_reader *r, int idx, const sem_pa
     sem_status st = sem_surface_sampler_build(&part->surface, &sampler, &perr);
     if (st == SEM_ERR_NOMEM) return nomem(r);
     sem_trim_projection_settings settings = sem_default_trim_projection_settings(&part->surface);
+    /* gaps between the curves: up to the file's own resolution, or 1e-4 of the surface */
+    settings.max_gap = fmax(settings.max_gap, r->resolution);
     sem_trim_loop loop;
+    double gap = 0;
     if (st == SEM_OK)
         st = sem_trim_project_loop(&sampler, model_space->c, model_space->n, &settings, &loop,
-                                   border, &perr);
+                                   border, &gap, &perr);
+    if (st == SEM_OK && gap > 0)
+        sem_model_warn(r->model, "entity %d (DE %d): a gap of %.3g between boundary curves is "
+                                 "bridged (allowed %.3g: the file's resolution or 1e-4 of the "
+                                 "surface)",
+                       r->entries[idx].type, de_number(idx), gap, settings.max_gap);
     sem_surface_sampler_free(&sampler);
     if (st == SEM_ERR_NOMEM) return nomem(r);
     if (st != SEM_OK) {
@@ -2000,9 +2128,10 @@ static sem_status curve_on_surface_entity(iges_reader *r, int owner, int k, int 
 }
 
 /* The loop of a 142 (parameter k of owner) into l: its parameter-space curve (BPTR); or,
- * when it has none or model_space is set (the surface is an unbounded plane fitted to the
- * boundary, whose (u,v) the file's curves do not know), its model-space curve (CPTR, in the
- * coordinates m) projected onto the part's surface. SEM_ERR_UNSUPPORTED (with a warning)
+ * when it has none or model_space is 1 (the surface is an unbounded plane fitted to the
+ * boundary, whose (u,v) the file's curves do not know) or 2 and there is one (the surface's
+ * parameters are not the file's), its model-space curve (CPTR, in the coordinates m)
+ * projected onto the part's surface. SEM_ERR_UNSUPPORTED (with a warning)
  * when neither works. *border: the loop is the surface's own border. */
 static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, const double *m,
                                    const sem_part *part, int model_space, curve_list *l,
@@ -2014,7 +2143,9 @@ static sem_status curve_on_surface(iges_reader *r, int owner, int k, int depth, 
     if (st == SEM_OK) st = param_ptr(r, p, 3, 1, &bptr);
     if (st == SEM_OK) st = param_ptr(r, p, 4, 1, &cptr);
     if (st != SEM_OK) return st;
-    if (bptr >= 0 && !model_space) return read_curves(r, bptr, identity_xf, depth + 1, l);
+    /* model_space 2 (inexact parameters): the model-space curve when there is one */
+    if (bptr >= 0 && (!model_space || (model_space == 2 && cptr < 0)))
+        return read_curves(r, bptr, identity_xf, depth + 1, l);
     if (cptr < 0) {
         sem_model_warn(r->model, "entity 142 (DE %d): no parameter-space curve (BPTR = 0) and no "
                                  "model-space curve (CPTR = 0); the loop is left out",
@@ -2048,7 +2179,9 @@ static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *
 }
 
 /* Reads the surface of a trimmed entity; an unbounded plane is fitted to the hint curves.
- * *from_hint: it was (its loops must then come from model space). */
+ * *from_hint: 1 it was (its loops must then come from model space); 2 the surface's
+ * parameters are not the file's (inexact_param: its loops come from model space where the
+ * file gives them there). */
 static sem_status read_trimmed_surface(iges_reader *r, int surf, const double *m, int depth,
                                        const curve_list *hint, sem_part *part, int *from_hint)
 {
@@ -2056,10 +2189,12 @@ static sem_status read_trimmed_surface(iges_reader *r, int surf, const double *m
     r->from_hint = 0;
     r->hint_fit = HINT_NONE;
     r->hint_seam = 0;
+    r->inexact_param = 0;
     sem_status st = read_surface(r, surf, m, depth + 1, part);
     r->surface_hint = 0;
-    *from_hint = st == SEM_OK && r->from_hint;
-    if (*from_hint && (r->hint_fit != HINT_NONE || r->hint_seam) && hint->n > 0) {
+    /* 1: the loops must come from model space; 2: better from there (inexact_param) */
+    *from_hint = st != SEM_OK ? 0 : r->from_hint ? 1 : r->inexact_param ? 2 : 0;
+    if (*from_hint == 1 && (r->hint_fit != HINT_NONE || r->hint_seam) && hint->n > 0) {
         size_t n = 0;
         for (int i = 0; i < hint->n; ++i) n += (size_t)hint->c[i].n_ctrl;
         double *points = malloc((n ? n : 1) * 3 * sizeof *points);
@@ -2210,6 +2345,19 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     return st;
 }
 
+/* The box of a (u,v) loop's control points: u0, u1, v0, v1 (it holds the loop's curves). */
+static void loop_box(const curve_list *l, double box[4])
+{
+    box[0] = box[2] = INFINITY;
+    box[1] = box[3] = -INFINITY;
+    for (int i = 0; i < l->n; ++i)
+        for (int j = 0; j < l->c[i].n_ctrl; ++j) {
+            const double *p = l->c[i].ctrl + 3 * j;
+            box[0] = fmin(box[0], p[0]), box[1] = fmax(box[1], p[0]);
+            box[2] = fmin(box[2], p[1]), box[3] = fmax(box[3], p[1]);
+        }
+}
+
 static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, int depth)
 {
     int surf, n;
@@ -2235,20 +2383,49 @@ static sem_status emit_bounded(iges_reader *r, int idx, const double *parent, in
     list_free(&hint);
     if (st == SEM_ERR_UNSUPPORTED) return SEM_OK;
     if (st != SEM_OK) return st;
-    curve_list l;
-    memset(&l, 0, sizeof l);
+    /* The loops first, then which one is outer: a 143 does not say (I-DEAS lists a plate's
+     * hole before its border: corpus occt_ideas_simple1_143), so the outer loop is the one
+     * whose (u,v) box holds every other loop's (the first when none does, as written), and
+     * none when a boundary is the surface's own border (the others are holes in it). */
+    curve_list *loops = calloc((size_t)(n > 0 ? n : 1), sizeof *loops);
+    if (!loops) {
+        sem_part_free(&part);
+        return nomem(r);
+    }
+    int n_loops = 0, no_outer = 0;
     for (int i = 0; (st == SEM_OK || st == SEM_ERR_UNSUPPORTED) && i < n; ++i) {
         int b, border = 0;
-        list_free(&l);
         st = param_ptr(r, idx, 4 + i, 0, &b);
-        if (st == SEM_OK) st = boundary_loop(r, b, m, depth + 1, &part, model_space, &l, &border);
-        if (st != SEM_OK || border) continue; /* border: the surface's own, nothing to trim */
-        if (i == 0)
-            set_outer(&part, &l);
-        else
-            st = add_hole(r, &part, &l);
+        if (st == SEM_OK)
+            st = boundary_loop(r, b, m, depth + 1, &part, model_space, &loops[n_loops], &border);
+        /* border: the surface's own, nothing to trim; a first boundary left out (warned):
+         * the rest are taken as holes, as written */
+        if ((st == SEM_OK && border) || (i == 0 && st != SEM_OK)) no_outer = 1;
+        if (st == SEM_OK && !border && loops[n_loops].n > 0) n_loops++;
+        else list_free(&loops[n_loops]);
     }
-    list_free(&l);
+    int outer = no_outer || n_loops == 0 ? -1 : 0;
+    for (int a = 0; outer >= 0 && a < n_loops; ++a) {
+        double box_a[4], box_b[4];
+        loop_box(&loops[a], box_a);
+        int holds_all = 1;
+        for (int b = 0; b < n_loops && holds_all; ++b) {
+            if (b == a) continue;
+            loop_box(&loops[b], box_b);
+            holds_all = box_a[0] <= box_b[0] && box_a[1] >= box_b[1] && box_a[2] <= box_b[2] &&
+                        box_a[3] >= box_b[3];
+        }
+        if (holds_all) {
+            outer = a;
+            break;
+        }
+    }
+    if (outer >= 0) set_outer(&part, &loops[outer]);
+    for (int a = 0; a < n_loops; ++a) {
+        if (a != outer && (st == SEM_OK || st == SEM_ERR_UNSUPPORTED)) st = add_hole(r, &part, &loops[a]);
+        list_free(&loops[a]);
+    }
+    free(loops);
     if (st != SEM_OK && st != SEM_ERR_UNSUPPORTED) {
         sem_part_free(&part);
         return st;

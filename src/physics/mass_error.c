@@ -123,14 +123,93 @@ sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows
     return SEM_OK;
 }
 
-/* Control points that no boundary sample sees (their basis functions are supported only
- * where a trim removed the surface) appear in no term of the discretization, so the system
- * would be singular. Each such point is tied to its own part's polynomial at its rest
- * position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a typical control point's
- * error term (*mean). It vanishes for every affine motion (the control points of an affinely
- * mapped NURBS are affinely mapped), so the patch test is unaffected. Lists them (control
- * point, part) in order. */
-static sem_status find_orphans(const sem_object *o, int **ctrl, int **part, int *n, double *mean,
+/* Bounds the elimination of one part's sample matrix (n w^2 / 2 multiply-adds, w its band):
+ * 5e8 is half a second; larger parts keep the column test only (see find_orphans). */
+#define UNSEEN_MAX_WORK 5e8
+/* A column whose pivot is at most this fraction of its own weight is taken as dependent on
+ * the columns before it: what the samples see of it, the others already show. */
+#define UNSEEN_RELATIVE_PIVOT 1e-9
+
+/* Part i's control points that its samples do not determine, by elimination of its sample
+ * matrix S_i = sum_s a_s J_s^T J_s (a_s with the error rows' floor, as the solvers see it;
+ * banded in the control net's order): column k is tied when its pivot, after the columns
+ * before it and the ties so far, is at most UNSEEN_RELATIVE_PIVOT of its diagonal; a tie
+ * adds its weight `mean` to the pivot, so S_i plus the ties is positive definite. (Exact
+ * dependence leaves pivots at round-off, 1e-13 and below; on the shared models the smallest
+ * pivot kept is 1.3e-4 of its diagonal.) Its samples are rows r0..r1-1 (sampling.c stores
+ * them part by part). Marks them in tied[] (local indices; columns no sample sees are
+ * marked already). Returns 0 when the part is too large to eliminate (its columns keep the
+ * column test) or out of memory. */
+static int part_unseen_points(const sem_object *o, int i, int r0, int r1, double mean,
+                              double floor, unsigned char *tied)
+{
+    const sem_discretization *d = o->d;
+    const sem_csr *J = &d->J_hat;
+    int c0 = d->part_ctrl_offset[i], n = d->part_ctrl_offset[i + 1] - c0;
+    /* the band: columns a sample couples are at most w apart */
+    int w = 0;
+    for (int r = r0; r < r1; ++r) {
+        if (J->row_start[r + 1] == J->row_start[r]) continue;
+        int lo = J->col[J->row_start[r]], hi = lo;
+        for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e) {
+            lo = J->col[e] < lo ? J->col[e] : lo;
+            hi = J->col[e] > hi ? J->col[e] : hi;
+        }
+        w = hi - lo > w ? hi - lo : w;
+    }
+    if ((double)n * w * w / 2 > UNSEEN_MAX_WORK) return 0;
+    size_t ld = (size_t)w + 1;
+    double *B = calloc((size_t)n * ld + 1, sizeof *B); /* B[a ld + (b - a)], b >= a */
+    if (!B) return 0;
+    double *diag = malloc((size_t)n * sizeof *diag + 1);
+    if (!diag) {
+        free(B);
+        return 0;
+    }
+    for (int r = r0; r < r1; ++r) {
+        double a_s = fmax(d->sample_area[r], floor);
+        for (int e = J->row_start[r]; e < J->row_start[r + 1]; ++e)
+            for (int f = J->row_start[r]; f < J->row_start[r + 1]; ++f) {
+                int a = J->col[e] - c0, b = J->col[f] - c0;
+                if (b >= a) B[(size_t)a * ld + (size_t)(b - a)] += a_s * J->val[e] * J->val[f];
+            }
+    }
+    for (int k = 0; k < n; ++k) diag[k] = B[(size_t)k * ld];
+    for (int k = 0; k < n; ++k) {
+        double *row = B + (size_t)k * ld;
+        if (tied[k] || !(row[0] > UNSEEN_RELATIVE_PIVOT * diag[k])) {
+            tied[k] = 1;
+            row[0] += mean;
+        }
+        double l = sqrt(row[0]);
+        int last = k + w < n - 1 ? k + w : n - 1;
+        for (int j = k + 1; j <= last; ++j) row[j - k] /= l;
+        for (int a = k + 1; a <= last; ++a) {
+            double f = row[a - k];
+            if (f == 0) continue;
+            double *ra = B + (size_t)a * ld;
+            for (int b = a; b <= last; ++b) ra[b - a] -= f * row[b - k];
+        }
+    }
+    free(B);
+    free(diag);
+    return 1;
+}
+
+/* Control points that the boundary samples do not determine appear in no term of the
+ * discretization, so the system would be singular. A column no sample sees (its basis
+ * function is supported only where a trim removed the surface, or outside the parameter
+ * range) is one; a part whose trim keeps a few samples where many basis functions overlap
+ * (a face trimmed to a small region of a large span, far inside its surface) has more
+ * columns than its samples can tell apart: those dependent columns are found by eliminating
+ * each part's sample matrix (part_unseen_points). Each such point is tied to its own part's
+ * polynomial at its rest position: residual q_c - b(X_c - Xbar)^T Pi_i Q, weighted like a
+ * typical control point's error term (*mean). It vanishes for every affine motion (the
+ * control points of an affinely mapped NURBS are affinely mapped), so the patch test is
+ * unaffected; and it only adds to directions the samples hold, so it cannot make the
+ * system singular. Lists them (control point, part) in order, and counts them per part in
+ * o->part_tied (for the warning that names the parts). */
+static sem_status find_orphans(sem_object *o, int **ctrl, int **part, int *n, double *mean,
                                sem_error *err)
 {
     const sem_csr *J = &o->d->J_hat;
@@ -138,8 +217,12 @@ static sem_status find_orphans(const sem_object *o, int **ctrl, int **part, int 
     *ctrl = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
     *part = malloc(((size_t)o->n_ctrl + 1) * sizeof(int));
     double *colw = calloc((size_t)o->n_ctrl + 1, sizeof(double));
-    if (!*ctrl || !*part || !colw) {
+    unsigned char *tied = calloc((size_t)o->n_ctrl + 1, 1);
+    free(o->part_tied);
+    o->part_tied = calloc((size_t)o->n_parts + 1, sizeof(int));
+    if (!*ctrl || !*part || !colw || !tied || !o->part_tied) {
         free(colw);
+        free(tied);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int r = 0; r < J->n_rows; ++r)
@@ -148,14 +231,37 @@ static sem_status find_orphans(const sem_object *o, int **ctrl, int **part, int 
     double mn = 0;
     for (int c = 0; c < o->n_ctrl; ++c) mn += colw[c];
     mn /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+    for (int c = 0; c < o->n_ctrl; ++c) tied[c] = !(colw[c] > 1e-10 * mn);
+    /* each part's sample rows (stored part by part); then the parts in parallel, each
+     * writing its own columns of tied[] */
+    int *row_start = calloc((size_t)o->n_parts + 2, sizeof(int));
+    if (!row_start) {
+        free(colw);
+        free(tied);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    for (int r = 0; r < J->n_rows; ++r) row_start[o->d->sample_part[r] + 1]++;
+    for (int i = 0; i < o->n_parts; ++i) row_start[i + 1] += row_start[i];
+    int ordered = 1;
+    for (int r = 1; r < J->n_rows; ++r) ordered &= o->d->sample_part[r] >= o->d->sample_part[r - 1];
+    double *floors = part_floors(o->d, o->n_parts);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
+    for (int i = 0; i < o->n_parts; ++i)
+        if (ordered && floors)
+            (void)part_unseen_points(o, i, row_start[i], row_start[i + 1], mn, floors[i],
+                                     tied + o->d->part_ctrl_offset[i]);
+    free(floors);
+    free(row_start);
     for (int i = 0; i < o->n_parts; ++i)
         for (int c = o->d->part_ctrl_offset[i]; c < o->d->part_ctrl_offset[i + 1]; ++c) {
-            if (colw[c] > 1e-10 * mn) continue;
+            if (!tied[c]) continue;
             (*ctrl)[*n] = c;
             (*part)[(*n)++] = i;
+            o->part_tied[i]++;
         }
     *mean = mn;
     free(colw);
+    free(tied);
     return SEM_OK;
 }
 

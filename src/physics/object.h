@@ -21,7 +21,7 @@
  *                    elastic_energy, qc
  *   object_welds.c   n_welds, weld_ctrl
  *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
- *                    n_orphans
+ *                    n_orphans, part_tied
  *   system_layout.c  free_index, n_free, system
  *   newton.c         exact_hessian (during a solve)
  */
@@ -88,6 +88,7 @@ typedef struct sem_object {
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
     int n_welds;               /* welded pairs (object_welds.c): weld_ctrl[2k], [2k + 1] */
     int *weld_ctrl;
+    int *part_tied;            /* per part: how many of its control points are tied */
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
     double gamma;

@@ -101,6 +101,7 @@ static void object_destroy(sem_object *o)
     free(o->group_ctrl);
     free(o->ctrl_group);
     free(o->ctrl_local);
+    free(o->part_tied);
     if (o->pi_dense)
         for (int i = 0; i < o->n_parts; ++i) free(o->pi_dense[i]);
     free(o->pi_dense);
@@ -450,6 +451,17 @@ double sem_world_time(const sem_world *w) { return w->time; }
 void sem_world_set_time(sem_world *w, double time) { w->time = time; }
 int sem_world_object_count(const sem_world *w) { return w->n_objects; }
 int sem_world_object_dofs(const sem_world *w, int i) { return 3 * w->objects[i]->n_ctrl; }
+int sem_world_object_tied_points(const sem_world *w, int i, int *part_counts)
+{
+    const sem_object *o = w->objects[i];
+    int total = 0;
+    for (int k = 0; k < o->n_parts; ++k) {
+        int n = o->part_tied ? o->part_tied[k] : 0;
+        if (part_counts) part_counts[k] = n;
+        total += n;
+    }
+    return total;
+}
 const double *sem_world_object_q(const sem_world *w, int i) { return w->objects[i]->q; }
 const double *sem_world_object_velocity(const sem_world *w, int i) { return w->objects[i]->v; }
 double sem_world_last_step_seconds(const sem_world *w) { return w->last_step_s; }

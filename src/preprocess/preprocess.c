@@ -213,6 +213,10 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
     sem_fnv_init(&f);
     sem_fnv_bytes(&f, sem_disc_magic, sizeof sem_disc_magic);
     fnv_int(&f, (int)SEM_DISC_FORMAT_VERSION);
+    /* Revision of what the steps compute for the same input, for cached results that a
+     * changed step would no longer give: 1 = the fits of groups whose weighted samples are
+     * flat (projection.c, decide_floored; issue 29). */
+    fnv_int(&f, 1);
     if (model) {
         fnv_int(&f, model->n_parts);
         for (int i = 0; i < model->n_parts; ++i) {

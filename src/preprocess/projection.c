@@ -215,6 +215,8 @@ static void quadratic_terms(const double p[3], double r[N2])
  * Rows of J are kept compact over the part's own control points. */
 typedef struct part_sums {
     double area, centroid_sum[3], spread_sum; /* rest moments (spread: sum a |X - Xbar|^2) */
+    int n_samples;
+    double floor;     /* 5 % of the mean sample area: the fit weights' floor (group floored) */
     double *T;  /* n_ctrl_i: sum a J */
     double *S1; /* 3 x n_ctrl_i: sum a p J */
     double *S2; /* 6 x n_ctrl_i: sum a r J (order 2) */
@@ -233,6 +235,7 @@ typedef struct group {
     double *R1;       /* 3 x n_cols: sum over the group of a p (J - t) */
     double *B2;       /* 6 x n_cols: sum over the group of a r (J - t) */
     double N1m[N1 * N1], N2m[N2 * N2], M21[N2 * N1];
+    int floored;      /* the fits weigh each sample at least its part's floor (see below) */
 } group;
 
 typedef struct context {
@@ -262,7 +265,46 @@ static void part_rest_moments(const context *cx, int i)
             r2 += (X[e] - Xbar[e]) * (X[e] - Xbar[e]);
         }
         ps->spread_sum += a * r2;
+        ps->n_samples++;
     }
+    ps->floor = ps->n_samples > 0 ? 0.05 * ps->area / ps->n_samples : 0.0;
+}
+
+/* Degenerate weights. The samples where a surface collapses (a cone's apex, a pole) have no
+ * area, so a part whose other samples are flat fits as if it were flat: a cone with a straight
+ * generatrix has its Lobatto points on the base circle and at the apex only (corpus
+ * occt_cone_catia), its group's linear fit had no z direction, F was singular at rest and the
+ * run ended "element inverted" before its first step. Such a group (its area-weighted samples
+ * flat, the same samples with the error rows' 5 % floor on each weight not) weighs each
+ * sample at least that floor in its fits; the centroid t_j keeps the areas, and since any
+ * weights fit affine motions exactly the patch test is unchanged. Groups whose samples span
+ * 3D as they are (every shared model) are untouched. */
+static void decide_floored(const context *cx, int j)
+{
+    const sem_discretization *d = cx->d;
+    group *g = &cx->groups[j];
+    const double *Xbar = d->origin_X + 3 * (size_t)j;
+    double raw[9] = {0}, fl[9] = {0};
+    for (int a = 0; a < g->n_parts; ++a) {
+        int i = g->parts[a];
+        for (int k = cx->sample_start[i]; k < cx->sample_start[i + 1]; ++k) {
+            int s = cx->sample_index[k];
+            double w = d->sample_area[s], wf = fmax(w, cx->sums[i].floor);
+            const double *X = d->sample_X + 3 * (size_t)s;
+            double p[3] = {(X[0] - Xbar[0]) / g->L, (X[1] - Xbar[1]) / g->L, (X[2] - Xbar[2]) / g->L};
+            for (int e = 0; e < 3; ++e)
+                for (int f = 0; f < 3; ++f) {
+                    raw[e * 3 + f] += w * p[e] * p[f];
+                    fl[e * 3 + f] += wf * p[e] * p[f];
+                }
+        }
+    }
+    double V[9], wr[3], wf[3];
+    jacobi_eigen(3, raw, wr, V);
+    jacobi_eigen(3, fl, wf, V);
+    double rmax = fmax(fmax(wr[0], wr[1]), wr[2]), rmin = fmin(fmin(wr[0], wr[1]), wr[2]);
+    double fmax_ = fmax(fmax(wf[0], wf[1]), wf[2]), fmin_ = fmin(fmin(wf[0], wf[1]), wf[2]);
+    g->floored = !(rmin > SEM_PROJECTION_NULL_TOL * rmax) && fmin_ > SEM_PROJECTION_NULL_TOL * fmax_;
 }
 
 static void part_fit_moments(const context *cx, int i)
@@ -274,9 +316,11 @@ static void part_fit_moments(const context *cx, int i)
     const double invL = 1.0 / cx->groups[j].L;
     const int off = d->part_ctrl_offset[i];
     const int nc = d->part_ctrl_offset[i + 1] - off;
+    const int floored = cx->groups[j].floored;
     for (int k = cx->sample_start[i]; k < cx->sample_start[i + 1]; ++k) {
         int s = cx->sample_index[k];
-        double a = d->sample_area[s];
+        /* t_j's sums keep the area (a0); the fits' weigh a (decide_floored) */
+        double a0 = d->sample_area[s], a = floored ? fmax(a0, ps->floor) : a0;
         const double *X = d->sample_X + 3 * (size_t)s;
         double p[3] = {(X[0] - Xbar[0]) * invL, (X[1] - Xbar[1]) * invL, (X[2] - Xbar[2]) * invL};
         double r[N2];
@@ -294,7 +338,7 @@ static void part_fit_moments(const context *cx, int i)
         for (int q = d->J_hat.row_start[s]; q < d->J_hat.row_start[s + 1]; ++q) {
             int c = d->J_hat.col[q] - off; /* checked to lie in [0, nc) beforehand */
             double aj = a * d->J_hat.val[q];
-            ps->T[c] += aj;
+            ps->T[c] += a0 * d->J_hat.val[q];
             for (int e = 0; e < N1; ++e) ps->S1[(size_t)e * nc + c] += aj * p[e];
             if (cx->order == 2)
                 for (int e = 0; e < N2; ++e) ps->S2[(size_t)e * nc + c] += aj * r[e];
@@ -631,6 +675,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
         ps->S2 = order == 2 ? calloc(N2 * (nc ? nc : 1), sizeof *ps->S2) : NULL;
         if (!ps->T || !ps->S1 || (order == 2 && !ps->S2)) goto nomem;
     }
+    for (int j = 0; j < n_origins; ++j) decide_floored(&cx, j);
 #pragma omp parallel for schedule(dynamic, 4) if (parallel)
     for (int i = 0; i < n_parts; ++i) part_fit_moments(&cx, i);
     for (int j = 0; j < n_origins; ++j)

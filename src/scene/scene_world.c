@@ -145,6 +145,44 @@ void sem_scene_world_destroy(sem_scene_world *sw)
     free(sw);
 }
 
+/* Control points the boundary samples do not determine (sem_world_object_tied_points): one
+ * warning per object naming the parts, so that a face kept untrimmed or trimmed to a sliver
+ * of its surface is seen; the run goes on with them tied to their parts' fits. */
+static void warn_tied_points(sem_scene_world *sw, int i, int id, const sem_scene_world_options *o)
+{
+    const sem_model *model = sw->models[i];
+    int *counts = calloc((size_t)model->n_parts + 1, sizeof *counts);
+    if (!counts) return;
+    int total = sem_world_object_tied_points(sw->world, id, counts);
+    if (total > 0) {
+        char parts[600] = "";
+        size_t len = 0;
+        int listed = 0, more = 0;
+        for (int k = 0; k < model->n_parts; ++k) {
+            if (!counts[k]) continue;
+            if (listed == 12) {
+                more++;
+                continue;
+            }
+            const char *nm = model->parts[k].name;
+            int of = model->parts[k].surface.n_u * model->parts[k].surface.n_v;
+            int w = nm[0] ? snprintf(parts + len, sizeof parts - len, "%s%d (%s; %d of its %d)",
+                                     listed ? ", " : "", k, nm, counts[k], of)
+                          : snprintf(parts + len, sizeof parts - len, "%s%d (%d of its %d)", listed ? ", " : "",
+                                     k, counts[k], of);
+            if (w > 0 && (size_t)w < sizeof parts - len) len += (size_t)w;
+            listed++;
+        }
+        if (more) snprintf(parts + len, sizeof parts - len, " and %d more part%s", more, more == 1 ? "" : "s");
+        logf_(o, 1,
+              "objects[%d]: %d control point%s seen by no boundary sample (outside the part's trim or "
+              "parameter range), tied to %s part's polynomial fit: part%s %s",
+              i, total, total == 1 ? " is" : "s are", total == 1 ? "its" : "their", listed + more == 1 ? "" : "s",
+              parts);
+    }
+    free(counts);
+}
+
 /* Zero-energy modes of object i: a warning naming the parts that are not held. */
 static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scene_world_options *o,
                               sem_error *err)
@@ -449,6 +487,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     int id = sem_world_add_object(sw->world, &od, err);
     release(&po);
     if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
+    warn_tied_points(sw, i, id, o);
     return o->skip_modes ? SEM_OK : check_modes(sw, i, id, o, err);
 }
 

@@ -22,7 +22,7 @@ def holl(s):
 
 class Ent:
     def __init__(self, type_, params, form=0, xform=0, status="00000000", label="",
-                 subscript=0, color=0):
+                 subscript=0, color=0, pd_count=None):
         self.type = type_
         self.params = params  # list of str, or callables of the DE map
         self.form = form
@@ -31,6 +31,7 @@ class Ent:
         self.label = label
         self.subscript = subscript
         self.color = color
+        self.pd_count = pd_count  # a wrong parameter line count to write (repair tests)
 
 
 def de(i):
@@ -90,7 +91,8 @@ def build(entities, unit_flag=6, unit_name="M", pd=",", rd=";", start="sem test 
     for i, e in enumerate(entities):
         d1 = "%8d%8d%8d%8d%8d%8d%8d%8d%8s" % (e.type, starts[i], 0, 0, 0, 0, e.xform, 0,
                                              e.status)
-        d2 = "%8d%8d%8d%8d%8d%8s%8s%8s%8d" % (e.type, 0, e.color, counts[i], e.form, "", "",
+        count = counts[i] if e.pd_count is None else e.pd_count
+        d2 = "%8d%8d%8d%8d%8d%8s%8s%8s%8d" % (e.type, 0, e.color, count, e.form, "", "",
                                              e.label, e.subscript)
         line(d1, "D", 2 * i + 1)
         line(d2, "D", 2 * i + 2)
@@ -120,11 +122,12 @@ def nurbs_curve(degree, knots, ctrl, weights=None, t0=None, t1=None, fmt=r):
     return p
 
 
-def nurbs_surface(du, dv, ku, kv, grid, weights=None, fmt=r, rng=None):
-    """grid[j][i] = point (i along u fastest, as IGES stores)."""
+def nurbs_surface(du, dv, ku, kv, grid, weights=None, fmt=r, rng=None, closed=(0, 0)):
+    """grid[j][i] = point (i along u fastest, as IGES stores); closed: PROP1, PROP2."""
     nu, nv = len(grid[0]), len(grid)
     weights = weights or [1.0] * (nu * nv)
-    p = [nu - 1, nv - 1, du, dv, 0, 0, 1 if all(w == 1 for w in weights) else 0, 0, 0]
+    p = [nu - 1, nv - 1, du, dv, closed[0], closed[1], 1 if all(w == 1 for w in weights) else 0,
+         0, 0]
     p += [fmt(k) for k in ku] + [fmt(k) for k in kv] + [fmt(w) for w in weights]
     for row in grid:
         for c in row:
@@ -531,6 +534,251 @@ def file_analytic():
     save("iges_analytic.igs", build(E))
 
 
+def file_unbounded_planes():
+    """A box [0,4] x [0,3] x [0,2] (millimetres) as CATIA and FreeCAD write planar faces:
+    each face a 144 on an unbounded 108 plane (PTR = 0) whose display symbol is 1.0 wide
+    and drawn at a point far from the face, trimmed by a 142 with model-space curves only
+    (BPTR = 0, PREF 2). The top face has a hole of radius 0.5 around (2, 1.5) (a 100 arc
+    at ZT = 2). The display size must not bound the plane: areas 12, 12 - pi / 4, 6, 6,
+    8, 8 (the corpus files occt_cone_catia and occt_cylinder_catia lost their caps).
+    Then two 143 bounded surfaces whose hole comes first (below)."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    box = [(0, 0, 0), (4, 0, 0), (4, 3, 0), (0, 3, 0),
+           (0, 0, 2), (4, 0, 2), (4, 3, 2), (0, 3, 2)]
+    # faces: plane coefficients (A, B, C, D) and the corners in loop order
+    faces = [((0, 0, -1, 0), (0, 3, 2, 1)), ((0, 0, 1, 2), (4, 5, 6, 7)),
+             ((-1, 0, 0, 0), (0, 4, 7, 3)), ((1, 0, 0, 4), (1, 2, 6, 5)),
+             ((0, -1, 0, 0), (0, 1, 5, 4)), ((0, 1, 0, 3), (3, 7, 6, 2))]
+    for k, (abcd, corners) in enumerate(faces):
+        t144 = add(None)
+        display = (100.0 + k, -50.0, 75.0)
+        plane = add(Ent(108, [r(x) for x in abcd] + ["0"] + [r(x) for x in display] + ["1.0"],
+                        status=sub))
+        lines = [add(Ent(110, line(box[corners[i]], box[corners[(i + 1) % 4]]), status=sub))
+                 for i in range(4)]
+        comp = add(Ent(102, ["4"] + [de(i) for i in lines], status=sub))
+        outer = add(Ent(142, ["0", de(plane), "0", de(comp), "2"], status=sub))
+        params = [de(plane), "1", "0", de(outer)]
+        if k == 1:
+            hole = add(Ent(100, ["2.0", "2.0", "1.5", "2.5", "1.5", "2.5", "1.5"], status=sub))
+            inner = add(Ent(142, ["0", de(plane), "0", de(hole), "2"], status=sub))
+            params = [de(plane), "1", "1", de(outer), de(inner)]
+        E[t144] = Ent(144, params)
+    # two 143s (141 TYPE 0, model space) on unbounded planes that list the hole before the
+    # outer boundary, as I-DEAS does (corpus occt_ideas_simple1_143): a triangle (0,0)-(6,0)-
+    # (0,6) at z = 5 around a hole of radius 1 at (1.5, 1.5): 18 - pi; the rectangle
+    # [0,4] x [0,3] at z = 7 (the fitted plane's own border) around a hole of radius 0.5 at
+    # (2, 1.5): 12 - pi / 4
+    for z, corners, centre, radius in ((5.0, [(0, 0), (6, 0), (0, 6)], (1.5, 1.5), 1.0),
+                                       (7.0, [(0, 0), (4, 0), (4, 3), (0, 3)], (2.0, 1.5), 0.5)):
+        t143 = add(None)
+        plane = add(Ent(108, ["0.0", "0.0", "1.0", r(z), "0", "-20.0", "30.0", r(z), "1.0"],
+                        status=sub))
+        hole = add(Ent(100, [r(z), r(centre[0]), r(centre[1]), r(centre[0] + radius),
+                             r(centre[1]), r(centre[0] + radius), r(centre[1])], status=sub))
+        h141 = add(Ent(141, ["0", "0", de(plane), "1", de(hole), "1", "0"], status=sub))
+        pts = [(x, y, z) for x, y in corners]
+        lines = [add(Ent(110, line(pts[i], pts[(i + 1) % len(pts)]), status=sub))
+                 for i in range(len(pts))]
+        outer = ["0", "0", de(plane), str(len(lines))]
+        for ln in lines:
+            outer += [de(ln), "1", "0"]
+        o141 = add(Ent(141, outer, status=sub))
+        E[t143] = Ent(143, ["0", de(plane), "2", de(h141), de(o141)])
+    save("iges_unbounded_planes.igs", build(E, unit_flag=2, unit_name="MM"))
+
+
+def file_unseen_points():
+    """Control points that no boundary sample sees (tests/test_unseen_points.c). A unit cube
+    of six bicubic patches (6 x 6 control points, 3 x 3 knot spans, control points at the
+    Greville abscissae: exact planes), and on its top face two more patches:
+    part 6: the top face again, trimmed (144, (u,v) circle) to a disc of radius 0.02 around
+            the middle of its middle span: the few samples inside see the 16 basis functions
+            of that span, but cannot tell them apart, and see none of the other 20;
+    part 7: the top face again, untrimmed, with the parameter range [0, 1/3] of its knots
+            [0, 1]: control points 4 and 5 of each row are supported outside it.
+    Before, either made the sample matrix singular ("a free control point is seen by no
+    boundary sample") or left zero-energy modes."""
+    knots = [0, 0, 0, 0, 1 / 3, 2 / 3, 1, 1, 1, 1]
+    greville = [sum(knots[i + 1:i + 4]) / 3 for i in range(6)]
+
+    def face(o, a, b, rng=None):
+        grid = [[tuple(o[d] + greville[i] * a[d] + greville[j] * b[d] for d in range(3))
+                 for i in range(6)] for j in range(6)]
+        return nurbs_surface(3, 3, knots, knots, grid, rng=rng)
+
+    cube = [((0, 0, 0), (0, 1, 0), (1, 0, 0)), ((0, 0, 1), (1, 0, 0), (0, 1, 0)),
+            ((0, 0, 0), (1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1), (1, 0, 0)),
+            ((0, 0, 0), (0, 0, 1), (0, 1, 0)), ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+    sub = "00010000"
+    E = [Ent(128, face(o, a, b)) for o, a, b in cube]
+    t144 = len(E)
+    E.append(None)
+    srf = len(E)
+    E.append(Ent(128, face((0, 0, 1), (1, 0, 0), (0, 1, 0)), status=sub))
+    circle = len(E)
+    E.append(Ent(100, ["0.0", "0.5", "0.5", "0.52", "0.5", "0.52", "0.5"], status=sub))
+    loop = len(E)
+    E.append(Ent(142, ["1", de(srf), de(circle), "0", "1"], status=sub))
+    E[t144] = Ent(144, [de(srf), "1", "0", de(loop)])
+    E.append(Ent(128, face((0, 0, 1), (1, 0, 0), (0, 1, 0), rng=(0, 1 / 3, 0, 1))))
+    save("iges_unseen_points.igs", build(E))
+
+
+def file_repairs():
+    """Defects Open CASCADE reads past, each repaired with a warning (corpus files in
+    brackets): unit flag 0 and no unit name [occt_rhino_bad_header] (inches, the IGES
+    default); a patch [0,2] x [0,1] whose range is written U0 V0 U1 V1
+    [occt_rhino_bounded_143] (the knots' range); its 144 loop of four 126 lines whose range
+    is written 0, 0 [occt_solidedge_deflector] (the knots' range, [-1, 0]); and a last
+    entity whose parameter line count runs past the Parameter section
+    [occt_rhino_bad_header] (the lines that point back to it). Areas 0.5 (the loop
+    [0.5, 1.5] x [0.25, 0.75]) and 1."""
+    sub = "00010000"
+    srf = nurbs_surface(1, 1, [0, 0, 2, 2], [0, 0, 1, 1],
+                        [[(0, 0, 0), (2, 0, 0)], [(0, 1, 0), (2, 1, 0)]])
+    srf[-4:] = ["0.0", "0.0", "2.0", "1.0"]  # U0 V0 U1 V1: read as [0, 0] x [2, 1], empty
+    E = [Ent(144, [de(1), "1", "0", de(2)]), Ent(128, srf, status=sub),
+         Ent(142, ["1", de(1), de(3), "0", "1"], status=sub),
+         Ent(102, ["4", de(4), de(5), de(6), de(7)], status=sub)]
+    # the loop [0.5, 1.5] x [0.25, 0.75] in (u,v): 126 lines on knots [-1, -1, 0, 0]
+    pts = [(0.5, 0.25, 0), (1.5, 0.25, 0), (1.5, 0.75, 0), (0.5, 0.75, 0)]
+    for k in range(4):
+        c = nurbs_curve(1, [-1, -1, 0, 0], [pts[k], pts[(k + 1) % 4]], t0=0.0, t1=0.0)
+        E.append(Ent(126, c[:-3], status=sub))  # no normal, as Solid Edge writes it
+    E.append(Ent(128, patch(0, 0, 1, 1, 1), pd_count=40))
+    save("iges_repairs.igs", build(E, unit_flag=0, unit_name=""))
+
+
+def file_seams():
+    """Trim loops on closed surfaces and loops with gaps (issue 29, item 2), each with a closed
+    form for its area:
+    part 0: the cylinder of radius 1, z 0..2 (closed in u, seam at (1, 0)), trimmed in (u,v)
+            by the rectangle u in [-0.25, 0.25], v in [0.25, 0.75]: it crosses the seam (as
+            corpus occt_torus_periodic's loop does): half the circumference, height 1: pi
+    part 1: the unit sphere, trimmed in (u,v) to the cap above latitude 45 degrees (v = 0.75):
+            the latitude, the seam meridian up, down again, without the edge along the pole
+            (SolidWorks and Solid Edge leave it out: corpus occt_solidworks_tube): 2 pi (1 -
+            sqrt(1/2))
+    part 2: a 120 cylinder (radius 1, axis z, line generatrix z 0..2, angles 0..2 pi) trimmed
+            by a 142 with both curves: in (u,v) the rectangle u in [0.25, 0.75] (the line's
+            parameter), v in [0.3, 1.3] (angles), in model space the same: the angle is not
+            the parameter of our rational circle, so the model-space curves are taken: 1
+    part 3: a 122 tabulated cylinder over a polyline of length 3 on [0, 3], extruded by 2,
+            trimmed in (u,v) by [0, 1] x [0, 0.5]: IGES's u runs over [0, 1] (corpus
+            dealii_side_inch): 3
+    part 4: the cylinder of part 0 trimmed by a model-space loop only, crossing the seam:
+            arcs at z 0.5 and 1.5 between -45 and 45 degrees, lines between them: pi / 2
+    part 5: the unit square plate trimmed by a model-space square [0.25, 0.75]^2 whose last
+            side stops 1e-4 short (more than the projection's tolerance, within 1e-4 of the
+            surface's size, sqrt 2): bridged with a warning: 0.25
+    (The closed surfaces say so, PROP1 = 1, as CAD files write them.)"""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    def lines_uv(pts):
+        return [add(Ent(110, line(pts[k], pts[(k + 1) % len(pts)]), status=sub))
+                for k in range(len(pts))]
+
+    def trimmed(srf, bptr_curves=None, cptr_curves=None, pref=1):
+        t = add(None)
+        b = add(Ent(102, [str(len(bptr_curves))] + [de(c) for c in bptr_curves], status=sub)) \
+            if bptr_curves else None
+        c = add(Ent(102, [str(len(cptr_curves))] + [de(x) for x in cptr_curves], status=sub)) \
+            if cptr_curves else None
+        loop = add(Ent(142, ["1" if b is not None else "0", de(srf), de(b) if b is not None else "0",
+                             de(c) if c is not None else "0", str(pref)], status=sub))
+        E[t] = Ent(144, [de(srf), "1", "0", de(loop)])
+
+    cylinder = nurbs_surface(2, 1, CIRCLE_KNOTS, [0, 0, 1, 1],
+                             [[(x, y, 0) for x, y in CIRCLE_XY], [(x, y, 2) for x, y in CIRCLE_XY]],
+                             CIRCLE_W * 2, closed=(1, 0))
+    # part 0
+    s0 = add(Ent(128, cylinder, status=sub))
+    trimmed(s0, lines_uv([(-0.25, 0.25, 0), (0.25, 0.25, 0), (0.25, 0.75, 0), (-0.25, 0.75, 0)]))
+    # part 1
+    merid = [(0, -1, 1), (1, -1, math.sqrt(0.5)), (1, 0, 1), (1, 1, math.sqrt(0.5)), (0, 1, 1)]
+    s1 = add(Ent(128, nurbs_surface(2, 2, CIRCLE_KNOTS, [0, 0, 0, 0.5, 0.5, 1, 1, 1],
+                                    [[(rho * x, rho * y, z) for x, y in CIRCLE_XY]
+                                     for rho, z, _ in merid],
+                                    [wu * wv for _, _, wv in merid for wu in CIRCLE_W],
+                                    closed=(1, 0)), status=sub))
+    cap = [add(Ent(110, line(p, q), status=sub)) for p, q in
+           [((0, 0.75, 0), (1, 0.75, 0)), ((1, 0.75, 0), (1, 1, 0)), ((0, 1, 0), (0, 0.75, 0))]]
+    trimmed(s1, cap)
+    # part 2
+    axis = add(Ent(110, line((0, 0, 0), (0, 0, 1)), status=sub))
+    gen = add(Ent(110, line((1, 0, 0), (1, 0, 2)), status=sub))
+    s2 = add(Ent(120, [de(axis), de(gen), "0.0", r(2 * math.pi)], status=sub))
+    a0, a1 = 0.3, 1.3
+    uv = lines_uv([(0.25, a0, 0), (0.75, a0, 0), (0.75, a1, 0), (0.25, a1, 0)])
+    ms = [add(Ent(100, [r(0.5), "0.0", "0.0", r(math.cos(a0)), r(math.sin(a0)), r(math.cos(a1)),
+                        r(math.sin(a1))], status=sub)),
+          add(Ent(110, line((math.cos(a1), math.sin(a1), 0.5), (math.cos(a1), math.sin(a1), 1.5)),
+                  status=sub)),
+          add(Ent(100, [r(1.5), "0.0", "0.0", r(math.cos(a0)), r(math.sin(a0)), r(math.cos(a1)),
+                        r(math.sin(a1))], status=sub)),
+          add(Ent(110, line((math.cos(a0), math.sin(a0), 1.5), (math.cos(a0), math.sin(a0), 0.5)),
+                  status=sub))]
+    trimmed(s2, uv, ms)
+    # part 3
+    poly = add(Ent(126, nurbs_curve(1, [0, 0, 1, 2, 3, 3], [(0, 0, 0), (1, 0, 0), (1, 1, 0),
+                                                          (0, 1, 0)]), status=sub))
+    s3 = add(Ent(122, [de(poly), "0.0", "0.0", "2.0"], status=sub))
+    trimmed(s3, lines_uv([(0, 0, 0), (1, 0, 0), (1, 0.5, 0), (0, 0.5, 0)]))
+    # part 4
+    s4 = add(Ent(128, cylinder, status=sub))
+    c45 = math.sqrt(0.5)
+    ms = [add(Ent(100, [r(0.5), "0.0", "0.0", r(c45), r(-c45), r(c45), r(c45)], status=sub)),
+          add(Ent(110, line((c45, c45, 0.5), (c45, c45, 1.5)), status=sub)),
+          add(Ent(100, [r(1.5), "0.0", "0.0", r(c45), r(-c45), r(c45), r(c45)], status=sub)),
+          add(Ent(110, line((c45, -c45, 1.5), (c45, -c45, 0.5)), status=sub))]
+    trimmed(s4, None, ms, pref=2)
+    # part 5
+    s5 = add(Ent(128, patch(0, 0, 0, 1, 1), status=sub))
+    sq = [(0.25, 0.25, 0), (0.75, 0.25, 0), (0.75, 0.75, 0), (0.25, 0.75, 0)]
+    ms = [add(Ent(110, line(sq[k], sq[(k + 1) % 4] if k < 3 else (0.25, 0.25 + 1e-4, 0)),
+                  status=sub)) for k in range(4)]
+    trimmed(s5, None, ms, pref=2)
+    save("iges_seams.igs", build(E))
+
+
+def file_cone_apex():
+    """A cone as CATIA writes it (corpus occt_cone_catia): a 120 surface of revolution of the
+    line from (60, 0, -70) to the apex (0, 0, 80) about the z axis, closed by an unbounded 108
+    plane z = -70 trimmed to the disc of radius 60 (model-space circle only), millimetres. The
+    generatrix has degree 1, so the cone's Lobatto points lie on its base circle and at its
+    apex, where the area element vanishes: weighted by area the group's samples are flat
+    (tests/test_unseen_points.c: the fit must still be exact, and the model simulated)."""
+    sub = "00010000"
+    E = []
+
+    def add(e):
+        E.append(e)
+        return len(E) - 1
+
+    axis = add(Ent(110, line((0, 0, 0), (0, 0, 1)), status=sub))
+    gen = add(Ent(110, line((60, 0, -70), (0, 0, 80)), status=sub))
+    add(Ent(120, [de(axis), de(gen), "0.0", r(2 * math.pi)]))
+    t144 = add(None)
+    plane = add(Ent(108, ["0.0", "0.0", "-1.0", "70.0", "0", "0.0", "0.0", "-70.0", "1.0"],
+                    status=sub))
+    circle = add(Ent(100, ["-70.0", "0.0", "0.0", "60.0", "0.0", "60.0", "0.0"], status=sub))
+    loop = add(Ent(142, ["0", de(plane), "0", de(circle), "2"], status=sub))
+    E[t144] = Ent(144, [de(plane), "1", "0", de(loop)])
+    save("iges_cone_apex.igs", build(E, unit_flag=2, unit_name="MM"))
+
+
 # ---------------------------------------------------------------- errors ----
 
 def good_curve_surface():
@@ -601,4 +849,9 @@ if __name__ == "__main__":
     file_model_space()
     file_model_space("iges_model_space_near.igs", 1e-4)
     file_analytic()
+    file_unbounded_planes()
+    file_unseen_points()
+    file_repairs()
+    file_seams()
+    file_cone_apex()
     errors()
