@@ -308,7 +308,7 @@ static void test_bad_scenes(const char *tmp)
     } cases[] = {
         {"scene_bad_key.json", "objects[0].material: unknown key \"desnity\"", "allowed"},
         {"scene_bad_model.json", "objects[0].model", "scene_no_such_model.igs: cannot open"},
-        {"scene_bad_pin.json", "objects[0].pin.box", "contains no control point"},
+        {"scene_bad_pin.json", "objects[0].pin.box", "holds none of the model's material"},
         {"scene_bad_dt.json", "integrator.dt", "must be positive"},
         {"scene_bad_nu.json", "objects[0].material", "poisson_ratio"},
         {"scene_bad_json.json", "scene_bad_json.json:4:", "not valid JSON"},

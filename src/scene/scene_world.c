@@ -412,7 +412,8 @@ static sem_status pin_regions(const sem_scene_object *so, const sem_discretizati
     int r = 0;
     for (int g = -1; g < so->n_prescribe_groups; ++g) {
         if (!(g < 0 ? so->has_pin_box : so->prescribe_groups[g].has_box)) continue;
-        const double *b = (*out)[r++].box;
+        double b[6];
+        memcpy(b, (*out)[r++].box, sizeof b);
         if (material_in_box(d, b)) continue;
         char key[64];
         if (g < 0)
