@@ -316,6 +316,44 @@ static void test_trimmed_bar(void)
     sem_model_destroy(plain);
 }
 
+/* What a box can hold (docs/scenes.md, pin): a part has one polynomial over the whole part
+ * (Eq. 7), so holding the material of a volume holds the polynomials of the parts blended there.
+ * The one-section beam (its four side faces run its length) held over its first 10 % hardly
+ * moves; held by a thin slab at its end face it sags as its control-point clamp does. */
+static void test_volume_hold(void)
+{
+    sem_error err;
+    sem_model *m = sem_model_create();
+    sem_beam_def bd = sem_default_beam_def(); /* 5 x 1 x 1, 1 section, biquadratic faces */
+    sem_discretization *d = NULL;
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.q_space_operators = 1;
+    if (!m || sem_primitive_beam(m, &bd, &err) != SEM_OK || sem_preprocess(m, &po, &d, &err) != SEM_OK) {
+        CHECK(0, "beam: %s", err.message);
+        sem_model_destroy(m);
+        return;
+    }
+    const sem_pin_region slab = {{-1, -1, -1, 0.001, 2, 2}, -1}, tenth = {{-1, -1, -1, 0.5, 2, 2}, -1};
+    unsigned char *clamp = control_box(m, slab.box);
+    double *qc = solve_static(m, d, clamp, NULL, 0, SEM_SOLVER_AUTO, "one-section beam, clamp");
+    double *qs = solve_static(m, d, NULL, &slab, 1, SEM_SOLVER_AUTO, "one-section beam, thin slab");
+    double *qt = solve_static(m, d, NULL, &tenth, 1, SEM_SOLVER_AUTO, "one-section beam, first 10 %");
+    if (qc && qs && qt) {
+        double sc = far_sag(d, qc, 5), ss = far_sag(d, qs, 5), st = far_sag(d, qt, 5);
+        printf("one-section beam, sag of the far 10 %%: control-point clamp %.4f m, material of x <= 0.001 %.4f m, "
+               "material of x <= 0.5 (volume of faces that run the length) %.4f m\n",
+               sc, ss, st);
+        CHECK(fabs(ss / sc - 1) <= 0.01, "thin slab %.4f vs clamp %.4f", ss, sc);
+        CHECK(st <= 0.01 * sc, "held over a volume of its faces the beam should barely move: %.4f of %.4f", st, sc);
+    }
+    free(qc);
+    free(qs);
+    free(qt);
+    free(clamp);
+    sem_discretization_destroy(d);
+    sem_model_destroy(m);
+}
+
 /* A 1 x 0.5 x 0.5 box (bicubic faces) refined by `refine`. */
 static sem_model *box(int refine)
 {
@@ -528,6 +566,7 @@ int main(void)
     if (!(fem > 0)) fem = 4.2387;
     test_cantilever(fem);
     test_trimmed_bar();
+    test_volume_hold();
     test_patch();
     test_solvers();
     return test_finish("test_pins");
