@@ -168,7 +168,9 @@ static void test_default_scene(const char *tmp)
     }
 
     /* the frames load back: same parts and control points as the generated beam; frame 0 is
-     * the rest shape and the clamped end (x = 0) does not move */
+     * the rest shape and the clamped end (x = 0) stays: its pin box holds the material there,
+     * which the end face's control points follow through the error energy (Eq. 16): 3.3e-6 m
+     * at frame 1 while the free end fell 3.0e-3 m (docs/simulation.md, "Pins") */
     sem_model *rest = sem_model_create();
     sem_beam_def bd = sem_default_beam_def();
     bd.sections = 4;
@@ -200,7 +202,8 @@ static void test_default_scene(const char *tmp)
             }
             if (f == 0) CHECK(moved <= 1e-12, "frame 0 differs from the rest shape by %g", moved);
             if (f > 0) CHECK(max_dz > 1e-3, "frame %d: the free end did not fall (%g)", f, max_dz);
-            CHECK(clamped <= 1e-12, "frame %d: the clamped end moved by %g", f, clamped);
+            CHECK(clamped <= 1e-2 * max_dz, "frame %d: the clamped end moved by %g (the free end %g)", f, clamped,
+                  max_dz);
         }
         sem_model_destroy(m);
     }
