@@ -168,7 +168,9 @@ static void test_default_scene(const char *tmp)
     }
 
     /* the frames load back: same parts and control points as the generated beam; frame 0 is
-     * the rest shape and the clamped end (x = 0) does not move */
+     * the rest shape and the clamped end (x = 0) stays: its pin box holds the material there,
+     * which the end face's control points follow through the error energy (Eq. 16): 3.3e-6 m
+     * at frame 1 while the free end fell 3.0e-3 m (docs/simulation.md, "Pins") */
     sem_model *rest = sem_model_create();
     sem_beam_def bd = sem_default_beam_def();
     bd.sections = 4;
@@ -200,7 +202,8 @@ static void test_default_scene(const char *tmp)
             }
             if (f == 0) CHECK(moved <= 1e-12, "frame 0 differs from the rest shape by %g", moved);
             if (f > 0) CHECK(max_dz > 1e-3, "frame %d: the free end did not fall (%g)", f, max_dz);
-            CHECK(clamped <= 1e-12, "frame %d: the clamped end moved by %g", f, clamped);
+            CHECK(clamped <= 1e-2 * max_dz, "frame %d: the clamped end moved by %g (the free end %g)", f, clamped,
+                  max_dz);
         }
         sem_model_destroy(m);
     }
@@ -312,7 +315,7 @@ static void test_bad_scenes(const char *tmp)
     } cases[] = {
         {"scene_bad_key.json", "objects[0].material: unknown key \"desnity\"", "allowed"},
         {"scene_bad_model.json", "objects[0].model", "scene_no_such_model.igs: cannot open"},
-        {"scene_bad_pin.json", "objects[0].pin.box", "contains no control point"},
+        {"scene_bad_pin.json", "objects[0].pin.box", "holds none of the model's material"},
         {"scene_bad_dt.json", "integrator.dt", "must be positive"},
         {"scene_bad_nu.json", "objects[0].material", "poisson_ratio"},
         {"scene_bad_json.json", "scene_bad_json.json:4:", "not valid JSON"},

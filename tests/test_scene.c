@@ -347,10 +347,12 @@ static void test_models_pins_materials(void)
     CHECK(sem_scene_load("/nonexistent/scene.json", &s, &err) != SEM_OK && strstr(err.message, "cannot open"),
           "missing scene: %s", err.message);
 
-    /* pins: a box around the x = 0 end of a 2-section beam selects exactly its control points:
-     * end cap 3x3 = 9, plus per side patch of section 1 its 3 points at x = 0: 4 x 3 = 12 */
+    /* pins: a control box around the x = 0 end of a 2-section beam selects exactly its control
+     * points: end cap 3x3 = 9, plus per side patch of section 1 its 3 points at x = 0: 4 x 3 =
+     * 12; a (material) box selects none and becomes a pin region held at rest */
     s = parse_object("\"primitive\": {\"type\": \"beam\", \"sections\": 2, \"length\": 2},"
-                     " \"pin\": {\"box\": [[-0.01, -1, -1], [0.01, 2, 2]], \"points\": [9]}",
+                     " \"pin\": {\"control_box\": [[-0.01, -1, -1], [0.01, 2, 2]], \"points\": [9],"
+                     "          \"box\": [[1.5, -1, -1], [3, 2, 2]]}",
                      "", &err);
     CHECK(s != NULL, "pin scene: %s", s ? "" : err.message);
     if (s) {
@@ -373,13 +375,20 @@ static void test_models_pins_materials(void)
             CHECK(count == 9 + 12 + 1, "pinned %zu", count);
             CHECK(bad == 0, "%zu wrongly pinned", bad);
             free(pin);
+            sem_pin_region *r = NULL;
+            int nr = -1;
+            CHECK(sem_scene_object_pin_regions(&s->objects[0], &r, &nr, &err) == SEM_OK && nr == 1 && r &&
+                      r[0].box[0] == 1.5 && r[0].box[5] == 2 && r[0].prescribe == -1,
+                  "pin region: %d", nr);
+            free(r);
             sem_model_destroy(m);
         }
         sem_scene_destroy(s);
     }
-    /* a pin box that selects nothing, a part or point that does not exist */
+    /* a control box that selects nothing, a part or point that does not exist (a material box
+     * that holds nothing is found with the discretization: sem_scene_world_create, test_run) */
     const char *bad_pins[][2] = {
-        {"\"pin\": {\"box\": [[5, 5, 5], [6, 6, 6]]}", "pin.box"},
+        {"\"pin\": {\"control_box\": [[5, 5, 5], [6, 6, 6]]}", "pin.control_box: [[5, 5, 5], [6, 6, 6]] contains no control point"},
         {"\"pin\": {\"parts\": [6]}", "pin.parts: part 6 does not exist"},
         {"\"pin\": {\"points\": [96]}", "pin.points: control point 96 does not exist"},
     };

@@ -71,7 +71,7 @@ class SemObjectSettings(bpy.types.PropertyGroup):
     pin_mode: EnumProperty(
         name="Pin", default="NONE",
         items=[("NONE", "None", "Nothing is held"),
-               ("BOX", "Box", "Control points inside a box (world coordinates) are held"),
+               ("BOX", "Box", "The material inside a box (world coordinates) is held"),
                ("VERTEX_GROUP", "Vertex group",
                 "The control points behind the vertices of a vertex group of the mesh parts "
                 "are held")])

@@ -24,10 +24,13 @@ typedef struct sem_scene_part_material {
     sem_material material;
 } sem_scene_part_material;
 
-/* One prescribed motion with its own control point selection ("prescribe": [...]). */
+/* One prescribed motion with its own selection ("prescribe": [...]): the material in box
+ * (sem_pin_region) and the control points in control_box, of parts, and points. */
 typedef struct sem_scene_prescribe_group {
     int has_box;
     double box[6];
+    int has_control_box;
+    double control_box[6];
     int n_parts;
     int *parts;
     int n_points;
@@ -60,8 +63,12 @@ typedef struct sem_scene_object {
      * of at most L / R (L the model's bounding-box diagonal), each with its own polynomial
      * (sem_model_patches); the frames hold the file's parts, refined at the cuts. */
     double resolution;
+    /* "pin": the material in pin_box is held (a material pin, sem_pin_region); the control
+     * points in pin_control_box, of pin_parts and pin_points are pinned */
     int has_pin_box;
     double pin_box[6];
+    int has_pin_control_box;
+    double pin_control_box[6];
     int n_pin_parts;
     int *pin_parts;
     int n_pin_points;
@@ -129,11 +136,18 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
 /* Metres per unit of a unit name ("mm", "M", "inch", ...; case-insensitive), 0 if unknown.
  * canonical (may be NULL, 16 chars) receives the IGES name ("MM", "M", "IN", ...). */
 double sem_unit_to_meter(const char *name, char *canonical);
-/* Per control point pin flags (1 = pinned) for the object's model; caller frees. */
+/* Per control point pin flags (1 = pinned: pin.control_box, pin.parts, pin.points) for the
+ * object's model, or *out = NULL when none is; caller frees. */
 sem_status sem_scene_object_pins(const sem_scene_object *obj, const sem_model *model,
                                  unsigned char **out, sem_error *err);
+/* The material pins (sem_object_def.pin_regions) of pin.box and of the prescribe groups'
+ * pin.box, in that order: the object's follows its single "prescribe" (or stays put), group g's
+ * follows group g (prescribes[g]). *out = NULL and *n = 0 when there are none; caller frees. */
+sem_status sem_scene_object_pin_regions(const sem_scene_object *obj, sem_pin_region **out, int *n,
+                                        sem_error *err);
 /* Per control point index into prescribe_groups (-1: none), or *out = NULL when the object
- * has no prescribe groups. A group that selects no control point is an error. */
+ * has no prescribe groups. A group that selects nothing (no control point, no material box)
+ * is an error. */
 sem_status sem_scene_object_prescribe_groups(const sem_scene_object *obj, const sem_model *model,
                                              int **out, sem_error *err);
 /* Per part material index into part_materials (or -1); caller frees. */

@@ -101,14 +101,34 @@ typedef struct sem_prescribe {
     double duration;        /* rotate only until this time (<= 0: forever) */
 } sem_prescribe;
 
-/* A load on the control points near a region: force per unit volume (N/m^3) applied to the
- * quadrature points inside the box, scaled by amplitude * (1 + sin(2 pi frequency t + phase))
- * / 2 when frequency > 0, or constant. */
+/* A load on the material of a region: force per unit volume (N/m^3) on the volume quadrature
+ * points whose rest position lies in the box (x = Gamma q there, so the force reaches the
+ * control points as Gamma^T f: the material is loaded, whatever control points lie in the
+ * box), scaled by (1 + sin(2 pi frequency t + phase)) / 2 when frequency > 0, or constant. */
 typedef struct sem_region_load {
     double box[6];          /* lo[3], hi[3] */
     double force_density[3];
     double frequency, phase;
 } sem_region_load;
+
+/* A material pin: the material inside the box - the volume quadrature points and boundary
+ * samples whose rest position lies in it (inclusive) - is held at its rest position, or moved
+ * by a prescription, as the fixed nodes of a finite element mesh are. Each such point X_a is
+ * tied to its target X_a(t) by the stiff anchor k / 2 w_a |x(X_a) - X_a(t)|^2 (w_a its volume,
+ * or for a sample its area times half the quadrature spacing h), k = SEM_PIN_STIFFNESS E / h^2
+ * (E the object's largest Young's modulus): the material moves about SEM_PIN_STIFFNESS times
+ * less than the body strains it to (src/physics/pins.h). Unlike a pinned control point
+ * (sem_object_def.pinned), it holds what lies in the box and nothing else: the control nets of
+ * trimmed faces reach far outside the faces. A box that holds no material is an error. */
+typedef struct sem_pin_region {
+    double box[6];          /* lo[3], hi[3], in the model's coordinates at rest */
+    int prescribe;          /* -1: held at rest; k >= 0: moves by prescribes[k] (with
+                               n_prescribes > 0), or by prescribe (k = 0, no prescribes) */
+} sem_pin_region;
+
+#ifndef SEM_PIN_STIFFNESS
+#define SEM_PIN_STIFFNESS 1e3
+#endif
 
 typedef struct sem_point_load {
     double X[3];            /* rest position where the force acts */
@@ -147,13 +167,18 @@ typedef struct sem_object_def {
     int weld;
     const unsigned char *pinned;         /* per control point, 1 = pinned; may be NULL */
     sem_prescribe prescribe;             /* motion of every pinned point (all points when
-                                            pinned is NULL), unless prescribe_group is given */
+                                            pinned is NULL and there are no pin_regions),
+                                            unless prescribe_group is given */
     /* Several prescribed groups (e.g. a twisting beam: one end fixed, the other rotating):
      * prescribe_group[c] indexes prescribes (-1: none). A point with a group is pinned and
      * follows that group's motion; other pinned points stay where they are. */
     const int *prescribe_group;
     const sem_prescribe *prescribes;
     int n_prescribes;
+    /* Material pins (sem_pin_region; copied): the material in each box held, or moved by its
+     * prescription. */
+    const sem_pin_region *pin_regions;
+    int n_pin_regions;
     double initial_velocity[3];
     double initial_angular_velocity[3];  /* about the centre of mass */
     const sem_point_load *point_loads;

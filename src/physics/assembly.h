@@ -87,8 +87,8 @@ void sem_basis_shift(int m, const double s[3], double *T);
  * slowly lose momentum conservation. Evaluating at the centred q removes that. */
 const double *sem_centered(sem_object *o, const double *q);
 
-/* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties) and their CSR
- * copy. */
+/* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties), A_blocks (the
+ * material pins, pins.h), and the CSR copy of M and E_blocks. */
 sem_status sem_mass_error_init(sem_object *o, sem_error *err);
 /* The boundary samples' weights in the error matrix are their areas, each at least 5 % of
  * its part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area
@@ -106,8 +106,9 @@ typedef struct sem_error_row {
 sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows, sem_error *err);
 /* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (into grad). */
 double sem_error_energy(sem_object *o, const double *q, double *grad);
-/* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x over all the object's dofs. */
-void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+/* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x + cA A x over all the object's dofs (A: the
+ * material pins' anchor, pins.h). */
+void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD, double cA,
                          const double *x, double *y);
 
 #endif

@@ -12,11 +12,12 @@
 #include "assembly.h"
 #include "contact/contact_world.h"
 #include "loads.h"
+#include "pins.h"
 #include "runaway.h"
 
 /*
  * Reusing the rest factor. The step's matrix is A = R + h^2 (K(q_n) - K0) with the rest matrix
- * R = (1 + h a) M + 2 h^2 gamma M_eps + (h^2 + h b) K0: everything but the stiffness is
+ * R = (1 + h a) M + 2 h^2 gamma M_eps + (h^2 + h b) K0 + h^2 A_pin: everything but the stiffness is
  * constant, and a stiff object (steel, the stiff mug) barely changes its stiffness from its
  * rest shape. Factorizing A every step (the paper's way; 80 % of the stiff mug's step) is
  * then wasted: R is factorized once, and the step solves A v = b by iterative refinement with
@@ -105,7 +106,7 @@ static sem_status solve_with_rest(sem_world *w, sem_system *s, const double *b, 
     size_t nf = 3 * (size_t)s->n_free;
     *solved = 0;
     int factored = 0;
-    sem_status st = sem_system_factorize_rest(s, 1.0 + h * a, h * h, h * h + h * bd, &factored, err);
+    sem_status st = sem_system_factorize_rest(s, 1.0 + h * a, h * h, h * h + h * bd, h * h, &factored, err);
     if (factored) {
         w->last_factor_s += sem_system_rest_factor_seconds(s);
         w->counters.factorizations++;
@@ -204,16 +205,19 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         double *fk = f + off, *gk = g + off, *rk = rhs + off, *tk = tmp + off, *vk = vp + off;
         /* otherwise the system's values are written as K's blocks are formed (structured
          * systems: the matrix's coefficients are recorded) */
-        const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
+        const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b, h * h}};
         if ((st = sem_assemble_elastic(o, o->q, lazy ? SEM_HESSIAN_POINTS : SEM_HESSIAN_FULL, gk,
                                        s->n_free > 0 && !lazy ? &fill : NULL, err)) != SEM_OK)
             goto done;
         sem_external_force(o, w->time, fk);
-        /* f_total = f_ext - grad V - 2 gamma M_eps q */
+        /* f_total = f_ext - grad V - 2 gamma M_eps q - grad E_pin; the pins' anchor is a
+         * quadratic with targets at t1, so with h^2 A in the matrix the step treats it exactly
+         * as backward Euler does (pins.h) */
         sem_error_energy(o, o->q, tk);
+        sem_pins_energy(o, o->q, t1, tk);
         for (size_t i = 0; i < no; ++i) fk[i] -= gk[i] + tk[i];
         /* rhs = M v + h f; damping enters the matrix: (M + hC + h^2K) v+ = M v + h f */
-        sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, rk);
+        sem_blocks_multiply(o, 1.0, 0, 0, 0, 0, o->v, rk);
         for (size_t i = 0; i < no; ++i) rk[i] += h * fk[i];
         /* prescribed velocities of pinned points, through A_fp */
         int any_pinned = 0;
@@ -227,10 +231,10 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         if (any_pinned) {
             if (lazy) {
                 /* K from the coefficient space (its q-space blocks are not formed yet) */
-                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, 0, h * b, vk, tk);
+                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, 0, h * b, h * h, vk, tk);
                 sem_point_hessian_multiply(o, h * h, 0, vk, tk, work);
             } else {
-                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, vk, tk);
+                sem_blocks_multiply(o, 1.0 + h * a, h * h * o->gamma, h * h, h * b, h * h, vk, tk);
             }
             for (size_t i = 0; i < no; ++i) rk[i] -= tk[i];
         }
@@ -269,7 +273,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
             if (lazy)
                 for (int k = 0; k < s->n_objects; ++k) {
                     sem_object *o = s->objects[k];
-                    const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b}};
+                    const sem_fill_target fill = {s, k, {1.0 + h * a, h * h * o->gamma, h * h, h * b, h * h}};
                     sem_assemble_kz_from_points(o);
                     if ((st = sem_assemble_stiffness_blocks(o, &fill, err)) != SEM_OK) goto done;
                 }

@@ -44,8 +44,9 @@ sem_status sem_loads_init(sem_object *o, const sem_object_def *def, sem_error *e
         }
     } else {
         o->presc[0] = def->prescribe;
-        if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned)
-            memset(o->pinned, 1, (size_t)o->n_ctrl); /* prescribe all control points */
+        /* prescribe all control points (an object with material pins moves those instead) */
+        if (def->prescribe.type != SEM_PRESCRIBE_NONE && !def->pinned && def->n_pin_regions <= 0)
+            memset(o->pinned, 1, (size_t)o->n_ctrl);
         for (int c = 0; c < o->n_ctrl; ++c)
             o->presc_index[c] = def->prescribe.type != SEM_PRESCRIBE_NONE && o->pinned[c] ? 0 : -1;
     }
@@ -64,14 +65,8 @@ sem_status sem_loads_gravity(sem_object *o, const double g[3], sem_error *err)
     return SEM_OK;
 }
 
-void sem_prescribed_position(const sem_object *o, double t, int c, double out[3])
+void sem_prescription_apply(const sem_prescribe *pr, double t, const double x0[3], double out[3])
 {
-    const double *x0 = o->q0 + 3 * c, *now = o->q + 3 * c;
-    if (o->presc_index[c] < 0) {
-        if (out != now) memcpy(out, now, 3 * sizeof(double));
-        return;
-    }
-    const sem_prescribe *pr = &o->presc[o->presc_index[c]];
     if (pr->type == SEM_PRESCRIBE_AFFINE) {
         const double *A = pr->affine;
         for (int r = 0; r < 3; ++r) out[r] = A[4 * r] * x0[0] + A[4 * r + 1] * x0[1] + A[4 * r + 2] * x0[2] + A[4 * r + 3];
@@ -90,9 +85,17 @@ void sem_prescribed_position(const sem_object *o, double t, int c, double out[3]
         double kdr = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
         for (int i = 0; i < 3; ++i)
             out[i] = pr->axis_point[i] + r[i] * cs + kxr[i] * sn + k[i] * kdr * (1 - cs);
+    }
+}
+
+void sem_prescribed_position(const sem_object *o, double t, int c, double out[3])
+{
+    const double *x0 = o->q0 + 3 * c, *now = o->q + 3 * c;
+    if (o->presc_index[c] < 0 || o->presc[o->presc_index[c]].type == SEM_PRESCRIBE_NONE) {
+        if (out != now) memcpy(out, now, 3 * sizeof(double));
         return;
     }
-    if (out != now) memcpy(out, now, 3 * sizeof(double));
+    sem_prescription_apply(&o->presc[o->presc_index[c]], t, x0, out);
 }
 
 void sem_external_force(const sem_object *o, double t, double *f)

@@ -23,6 +23,9 @@
 sem_status sem_loads_init(sem_object *o, const sem_object_def *def, sem_error *err);
 /* f_gravity for gravity g (needs the object's point_rho_vol). */
 sem_status sem_loads_gravity(sem_object *o, const double g[3], sem_error *err);
+/* A prescription applied to a rest position x0 at time t (out unchanged for
+ * SEM_PRESCRIBE_NONE): the pinned control points' motion, and the material pins' (pins.h). */
+void sem_prescription_apply(const sem_prescribe *pr, double t, const double x0[3], double out[3]);
 /* Where pinned control point c is at time t: its prescription applied to its rest position,
  * or (no prescription) where it is now. */
 void sem_prescribed_position(const sem_object *o, double t, int c, double out[3]);

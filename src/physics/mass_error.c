@@ -1,10 +1,11 @@
 /*
  * mass_error.c - the constant matrices of an object: the mass matrix M with per-point
- * density (Eq. 14) and the error matrix M_eps (Eq. 16), with the ties of orphan control
- * points, as group-pair blocks (object.h) and a CSR copy; the error energy and products
- * with the object's matrices.
+ * density (Eq. 14), the error matrix M_eps (Eq. 16) with the ties of orphan control points,
+ * and the material pins' anchor A (pins.h), as group-pair blocks (object.h) and a CSR copy;
+ * the error energy and products with the object's matrices.
  */
 #include "assembly.h"
+#include "pins.h"
 #include "structured.h"
 
 #include <cblas.h>
@@ -282,6 +283,14 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         free(Mz);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
+    /* the material pins' anchor: the mass matrix's form with k w_a for rho vol (pins.h) */
+    double *Az = o->pins ? calloc((size_t)np * m * m + 1, sizeof(double)) : NULL;
+    if (o->pins && !Az) {
+        free(Mz);
+        free(Bz);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    }
+    sem_pins_add_pair_blocks(o, Az);
     const sem_csr *W = &o->d->W;
     for (int p = 0; p < o->n_quad; ++p) {
         double rv = o->point_rho_vol[p];
@@ -307,25 +316,29 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
             }
     }
     if (o->structured) {
-        /* the pair blocks are the structured form's Mz and Bz (structured.h) */
+        /* the pair blocks are the structured form's Mz, Bz and Az (structured.h) */
         int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
         double tie_weight = 0;
         sem_status st = find_orphans(o, &tie_ctrl, &tie_part, &n_ties, &tie_weight, err);
         if (st == SEM_OK)
-            st = sem_structured_init(o, Mz, Bz, n_ties, tie_ctrl, tie_part, tie_weight, SEM_WELD_STIFFNESS * tie_weight,
-                                     err);
+            st = sem_structured_init(o, Mz, Bz, Az, n_ties, tie_ctrl, tie_part, tie_weight,
+                                     SEM_WELD_STIFFNESS * tie_weight, err);
         o->n_orphans = n_ties;
         free(tie_ctrl);
         free(tie_part);
         free(Mz);
         free(Bz);
+        free(Az);
         return st;
     }
     size_t mg = sem_max_group_size(o);
     double *tmp = malloc((size_t)m * mg * sizeof(double));
-    if (!tmp) {
+    if (Az) o->A_blocks = calloc(o->gpair_offset[o->n_gpairs] + 1, sizeof(double));
+    if (!tmp || (Az && !o->A_blocks)) {
+        free(tmp);
         free(Mz);
         free(Bz);
+        free(Az);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int k = 0; k < np; ++k) {
@@ -335,10 +348,14 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
         if (Bz)
             add_projected(o, o->pair_a[k], o->pair_b[k], Bz + (size_t)k * m * m, m,
                           o->E_blocks + o->gpair_offset[g], tmp);
+        if (Az)
+            add_projected(o, o->pair_a[k], o->pair_b[k], Az + (size_t)k * m * m, m,
+                          o->A_blocks + o->gpair_offset[g], tmp);
     }
     free(tmp);
     free(Mz);
     free(Bz);
+    free(Az);
     /* the orphan control points' ties (find_orphans) */
     {
         int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
@@ -529,22 +546,34 @@ sem_status sem_mass_error_init(sem_object *o, sem_error *err)
     return st;
 }
 
+static void q_space_multiply(const sem_object *o, double cM, double cE, double cK, double cD, const double *x,
+                             double *y);
+
 double sem_error_energy(sem_object *o, const double *q, double *grad)
 {
     const double *qc = sem_centered(o, q);
-    sem_blocks_multiply(o, 0, o->gamma, 0, 0, qc, grad);
+    sem_blocks_multiply(o, 0, o->gamma, 0, 0, 0, qc, grad);
     double e = 0;
     for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) e += 0.5 * qc[i] * grad[i];
     return e;
 }
 
-void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
-                            const double *x, double *y)
+void sem_blocks_multiply(const sem_object *o, double cM, double cE, double cK, double cD, double cA,
+                         const double *x, double *y)
 {
     if (o->structured) {
-        sem_structured_multiply(o, cM, cE, cK, cD, x, y);
+        sem_structured_multiply(o, cM, cE, cK, cD, cA, x, y);
         return;
     }
+    q_space_multiply(o, cM, cE, cK, cD, x, y);
+    /* the pins' anchor through its few points (pins.c), not its blocks */
+    sem_pins_multiply(o, cA, x, y);
+}
+
+/* y = (cM M + 2 cE M_eps + cK K + cD K0) x from the q-space blocks. */
+static void q_space_multiply(const sem_object *o, double cM, double cE, double cK, double cD, const double *x,
+                             double *y)
+{
     if (cK == 0 && cD == 0) {
         /* mass and error matrix only: by rows in parallel */
 #pragma omp parallel for schedule(static) num_threads(o->nthreads)

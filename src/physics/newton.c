@@ -16,13 +16,14 @@
 #include "assembly.h"
 #include "contact/contact_world.h"
 #include "loads.h"
+#include "pins.h"
 #include "point_terms.h"
 
 /* One solve: the world's settings, the system, and its vectors (n_dofs each). */
 typedef struct newton {
     sem_world *w;
     sem_system *s;
-    double h, cD;
+    double h, cD, t1;             /* t1: the time solved for (the pins' targets) */
     int dynamic;
     const double *qn, *qpred, *f; /* the step's start, prediction q_n + h v_n, loads */
     double *tmp, *dq;             /* scratch */
@@ -31,7 +32,8 @@ typedef struct newton {
 /* The line search compares energies by their differences. The potential is the elastic
  * energy V and the contact potential Ec (sums of small non-negative terms, accurate to
  * round-off of their size) plus a quadratic Q(q) = 1/2 q^T A q - b^T q: inertia, damping,
- * loads and the error energy (A = cM M + 2 gamma M_eps + cD K0). Q itself is a sum of large
+ * loads, the error energy and the material pins' anchor (A = cM M + 2 gamma M_eps + cD K0 +
+ * A_pin, pins.h). Q itself is a sum of large
  * terms that cancel (gamma M_eps has entries far larger than the energy, since gamma is
  * stiff), so evaluating it at two points and subtracting loses the few digits a converging
  * Newton step changes (measured: 1e-9 of an energy of 1 on a refined box, where a step
@@ -64,12 +66,12 @@ static void quadratic_multiply(const newton *nt, double cM, const double *x, dou
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t off = s->dof_offset[k];
-        sem_blocks_multiply(o, cM, o->gamma, 0, nt->cD, x + off, y + off);
+        sem_blocks_multiply(o, cM, o->gamma, 0, nt->cD, 1.0, x + off, y + off);
     }
 }
 
 /* The gradient g of E at q and, with the objects' K blocks, the Hessian's stiffness part:
- * grad V + 2 gamma M_eps q - f + M (q - q_pred) / h^2 + damping + contact. gq: the gradient of
+ * grad V + 2 gamma M_eps q + grad E_pin - f + M (q - q_pred) / h^2 + damping + contact. gq: the gradient of
  * the quadratic part alone; *vc: V + Ec at q. */
 static sem_status gradient(const newton *nt, const double *q, double *g, double *gq, double *vc,
                            sem_error *err)
@@ -87,14 +89,15 @@ static sem_status gradient(const newton *nt, const double *q, double *g, double 
         if (st != SEM_OK) return st;
         *vc += o->elastic_energy;
         sem_error_energy(o, x, qk);
+        sem_pins_energy(o, x, nt->t1, qk);
         for (size_t i = 0; i < n; ++i) qk[i] -= f[i];
         if (nt->dynamic) {
             for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qpred[i];
-            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, dq, tmp);
+            sem_blocks_multiply(o, 1.0 / (h * h), 0, 0, 0, 0, dq, tmp);
             for (size_t i = 0; i < n; ++i) qk[i] += tmp[i];
             if (nt->cD > 0 || w->def.rayleigh_mass > 0) {
                 for (size_t i = 0; i < n; ++i) dq[i] = x[i] - qn[i];
-                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, dq, tmp);
+                sem_blocks_multiply(o, w->def.rayleigh_mass / h, 0, 0, nt->cD, 0, dq, tmp);
                 for (size_t i = 0; i < n; ++i) qk[i] += tmp[i];
             }
         }
@@ -115,7 +118,7 @@ static void set_exact_hessian(sem_system *s, int on)
 /* Fills the system's matrix with the Hessian, factorizes it and counts that. */
 static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, sem_error *err)
 {
-    sem_system_fill(s, cM, 1.0, 1.0, cD);
+    sem_system_fill(s, cM, 1.0, 1.0, cD, 1.0);
     /* contact: its Hessian (point_terms.h) */
     const sem_point_terms *contact = sem_contact_terms(w->contact);
     const double one = 1.0;
@@ -166,7 +169,7 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
     gathered = 1;
     double qscale = 0;
     for (size_t i = 0; i < n; ++i) qscale = fmax(qscale, fabs(q[i]));
-    const newton nt = {w, s, h, cD, dynamic, qn, qpred, f, tmp, dq};
+    const newton nt = {w, s, h, cD, t1, dynamic, qn, qpred, f, tmp, dq};
     double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0;
     int it, full_steps = 0, exact_allowed = !w->def.advanced.projected_hessian, converged = 0, search_failed = 0;
     set_exact_hessian(s, 0);

@@ -20,8 +20,9 @@
  *   assembly.c       the shared basis, point lists, z-space work, K_blocks,
  *                    elastic_energy, qc
  *   object_welds.c   n_welds, weld_ctrl
+ *   pins.c           pins (material pins: the anchored points)
  *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
- *                    n_orphans, part_tied
+ *                    A_blocks (the pins' anchor), n_orphans, part_tied
  *   system_layout.c  free_index, n_free, system
  *   newton.c         exact_hessian (during a solve)
  */
@@ -34,6 +35,7 @@
 #include "sem/simulation.h"
 
 struct sem_system;
+struct sem_pins;
 
 typedef struct sem_object {
     sem_object_def def;
@@ -85,6 +87,8 @@ typedef struct sem_object {
     int *me_start, *me_col;    /* M and E_blocks as one CSR pattern over control points */
     double *me_M, *me_E;
     double *K0_blocks;         /* rest stiffness, for Rayleigh damping */
+    double *A_blocks;          /* the material pins' anchor (pins.h), gpair_offset[n]; NULL
+                                * without pins */
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
     int n_welds;               /* welded pairs (object_welds.c): weld_ctrl[2k], [2k + 1] */
     int *weld_ctrl;
@@ -92,6 +96,7 @@ typedef struct sem_object {
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
     double gamma;
+    struct sem_pins *pins;     /* material pins (pins.h), NULL when none */
     /* free dofs */
     unsigned char *pinned;
     int *presc_index;          /* per ctrl: prescription followed, or -1 (stays put) */

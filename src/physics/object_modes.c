@@ -48,14 +48,14 @@ typedef struct modes_ctx {
 static int mult_M(void *u, const double *x, double *y)
 {
     modes_ctx *c = u;
-    sem_blocks_multiply(c->o, 1.0, 0, 0, 0, x, y);
+    sem_blocks_multiply(c->o, 1.0, 0, 0, 0, 0, x, y);
     return 0;
 }
 
 static int mult_K(void *u, const double *x, double *y)
 {
     modes_ctx *c = u;
-    sem_blocks_multiply(c->o, 0, c->o->gamma, 0, 1.0, x, y);
+    sem_blocks_multiply(c->o, 0, c->o->gamma, 0, 1.0, 0, x, y);
     return 0;
 }
 
@@ -103,7 +103,8 @@ sem_status sem_world_object_modes(sem_world *w, int object, sem_object_modes *ou
     if ((st = sem_system_create(list, 1, w->def.solver, &s, err)) != SEM_OK) goto done;
     c.s = s;
     double sigma = 1e-3 * lref;
-    sem_system_fill(s, sigma, 1.0, 0, 1.0);
+    /* the free object: no pins of any kind (the anchor's coefficient is 0) */
+    sem_system_fill(s, sigma, 1.0, 0, 1.0, 0);
     if ((st = sem_system_factorize(s, err)) != SEM_OK) {
         /* K + sigma M is singular: motions with neither mass nor stiffness */
         if (st == SEM_ERR_NUMERIC)

@@ -6,14 +6,15 @@
  * any input doing work; the state then grows by orders of magnitude within a few steps.
  * After every step the object's mechanical energy
  *
- *   E_mech = 1/2 v^T M v + elastic + error energy - f_ext(t) . (q - q0)
+ *   E_mech = 1/2 v^T M v + elastic + error energy + E_pin(t) - f_ext(t) . (q - q0)
  *
- * (the last term is the exact potential of gravity and of constant loads) is compared with
+ * (E_pin: the material pins' anchor, pins.h; the last term is the exact potential of gravity
+ * and of constant loads) is compared with
  * a budget fixed at the first step: what the inputs can supply when the object moves by its
  * own size L,
  *
  *   B = E_mech(0) + m |g| L + sum |F| L + sum |f| V L + 1e-6 E V  (+ E V with prescribed
- *       motion, which can strain the body by order 1)
+ *       motion of pinned control points or material, which can strain the body by order 1)
  *
  * (F point loads, f region force densities, V the volume, E the largest Young's modulus; the
  * last terms keep B away from zero). E_mech > RUNAWAY_FACTOR B is a runaway. A dissipative
@@ -29,6 +30,7 @@
 
 #include "assembly.h"
 #include "loads.h"
+#include "pins.h"
 
 #define RUNAWAY_FACTOR 1e4
 
@@ -42,13 +44,13 @@ static double largest_modulus(const sem_object *o)
 static double mechanical_energy(sem_object *o, double t, double *tmp, double *f)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
-    sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
+    sem_blocks_multiply(o, 1.0, 0, 0, 0, 0, o->v, tmp);
     double kin = 0, pot = 0;
     for (size_t i = 0; i < n; ++i) kin += 0.5 * o->v[i] * tmp[i];
     double err_e = sem_error_energy(o, o->q, tmp);
     sem_external_force(o, t, f);
     for (size_t i = 0; i < n; ++i) pot -= f[i] * (o->q[i] - o->q0[i]);
-    return kin + o->elastic_energy + err_e + pot;
+    return kin + o->elastic_energy + err_e + sem_pins_energy(o, o->q, t, NULL) + pot;
 }
 
 sem_status sem_runaway_init(sem_object *o, const double gravity[3], sem_error *err)
@@ -65,6 +67,7 @@ sem_status sem_runaway_init(sem_object *o, const double gravity[3], sem_error *e
     double g = sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]);
     int moves = 0; /* prescribed motion (pins that stay put do no work) */
     for (int k = 0; k < o->n_presc; ++k) moves |= o->presc[k].type != SEM_PRESCRIBE_NONE;
+    if (o->pins) moves |= o->pins->moves;
     double b = fabs(e) + o->mass * g * L + 1e-6 * E * V + (moves ? E * V : 0);
     for (int k = 0; k < o->def.n_point_loads; ++k) {
         const double *F = o->def.point_loads[k].force;

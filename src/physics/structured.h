@@ -13,13 +13,14 @@
  *             with S0 = sum_s a_s J_s^T J_s (sparse, one block per part), G = sum_s a_s g_s^T J_s,
  *             Bb = sum_s a_s g_s^T g_s
  *   K, K0   = P'^T Kz P'     (Kz per part pair in the shared basis, P' = pi_shared; Eq. 15)
+ *   A       = P^T Az P       (the material pins' anchor, pins.h: Mz's form with k w_a for rho vol)
  *
  * (The orphan ties of mass_error.c are samples too: J = e_c, g = b(X_c - Xbar) on the part;
  * and so are the welds of object_welds.c: J = e_a - e_b, g = 0.)
- * So the system matrix A = cM M + c M_eps + cK K + cD K0 (c = 2 cE gamma) is
+ * So the system matrix A = cM M + c M_eps + cK K + cD K0 + cA A (c = 2 cE gamma) is
  *
  *   A = c S0 + V^T Mid V,   V = [P; G],   Mid = [[Z, -c I], [-c I, 0]],
- *   Z = c (Bb + Bz) + cM Mz + cK Kz + cD K0z   (coefficient space, 3 n_parts m square)
+ *   Z = c (Bb + Bz) + cM Mz + cK Kz + cD K0z + cA Az   (coefficient space, 3 n_parts m square)
  *
  * and Woodbury gives A^-1 = S^-1 - S^-1 V^T Cap^-1 V S^-1 with S = c S0 and
  * Cap = Mid^-1 + V S^-1 V^T = (1/c) [[F1, F2 - I], [F2^T - I, F3 - Z/c]], F = V S0^-1 V^T.
@@ -53,23 +54,25 @@ typedef struct sem_structured_ops {
     double *j_val;
     int *g_start, *g_idx; /* g_s over coefficients (i m + k) */
     double *g_val;
-    /* Mz with density, Bb, Bz (blend, over gamma): r0 x r0, stored by part-pair blocks
-     * (m x m, row-major) for the pairs (a, b) with any non-zero entry: nb_part lists the parts
-     * b of part a, ascending, from nb_start[a]; entry e's blocks start at e m^2 */
+    /* Mz with density, Bb, Bz (blend, over gamma), Az (the pins' anchor; NULL without pins):
+     * r0 x r0, stored by part-pair blocks (m x m, row-major) for the pairs (a, b) with any
+     * non-zero entry: nb_part lists the parts b of part a, ascending, from nb_start[a]; entry
+     * e's blocks start at e m^2 */
     int *nb_start, *nb_part;
-    double *Mz, *Bb, *Bz;
+    double *Mz, *Bb, *Bz, *Az;
 } sem_structured_ops;
 
-/* structured_operators.c: builds o->ops from the discretization, the pair blocks Mz and Bz
- * of mass_error.c (n_pairs x m x m, or NULL), the orphan ties (control point, its part,
+/* structured_operators.c: builds o->ops from the discretization, the pair blocks Mz, Bz and
+ * Az of mass_error.c (n_pairs x m x m, or NULL), the orphan ties (control point, its part,
  * weight) and the welds of o (o->weld_ctrl: rows e_a - e_b of weight weld_weight, no
  * coefficient part). */
 sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
-                               int n_ties, const int *tie_ctrl, const int *tie_part,
+                               const double *Az_pairs, int n_ties, const int *tie_ctrl, const int *tie_part,
                                double tie_weight, double weld_weight, sem_error *err);
 void sem_structured_free(sem_object *o);
-/* y = cM M x + 2 cE M_eps x + cK K x + cD K0 x over all the object's dofs (x, y: 3 n_ctrl). */
-void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+/* y = cM M x + 2 cE M_eps x + cK K x + cD K0 x + cA A x over all the object's dofs (x, y:
+ * 3 n_ctrl). */
+void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD, double cA,
                              const double *x, double *y);
 /* The coefficient-space stiffness of part pair (a, b) in the parts' own bases:
  * out (3m x 3m, rows 3k + d of a, columns 3l + d' of b) = R_a^T Kz_ab R_b, from a shared-basis
@@ -81,9 +84,9 @@ typedef struct sem_structured_solver sem_structured_solver;
 /* The solver of o's free dofs (o->free_index). */
 sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **out, sem_error *err);
 void sem_structured_solver_destroy(sem_structured_solver *s);
-/* The matrix c[0] M + 2 c[1] M_eps + c[2] K + c[3] K0 (c[1] includes gamma), with K the
- * object's current Kz; c[1] > 0. */
-void sem_structured_solver_set(sem_structured_solver *s, const double c[4]);
+/* The matrix c[0] M + 2 c[1] M_eps + c[2] K + c[3] K0 + c[4] A (c[1] includes gamma), with K
+ * the object's current Kz; c[1] > 0. */
+void sem_structured_solver_set(sem_structured_solver *s, const double c[5]);
 sem_status sem_structured_solver_factorize(sem_structured_solver *s, sem_error *err);
 /* x = A^-1 b over the object's free dofs (3 n_free, interleaved; x may alias b). */
 sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b, double *x,

@@ -4,7 +4,7 @@
  * (by part-pair blocks: a part's coefficients meet only those of the parts it shares a point or
  * a sample with, so a dense r0 x r0 matrix would be mostly zeros; NIST CTC-02 has 637 parts:
  * 325 MB each, scanned whole by every product), and the products with M, M_eps, K and K0 that
- * never form a q-space matrix.
+ * never form a q-space matrix (and Az, the material pins' anchor, pins.h).
  *
  * Products are summed in a fixed order whatever the thread count: P x by rows (one part's
  * rows per task), P^T y by groups (every control point is in one group, and a group sums its
@@ -37,6 +37,7 @@ void sem_structured_free(sem_object *o)
     free(s->Mz);
     free(s->Bb);
     free(s->Bz);
+    free(s->Az);
     free(s);
     o->ops = NULL;
 }
@@ -199,7 +200,8 @@ static sem_status build_neighbours(const sem_object *o, sem_structured_ops *s, s
     s->Mz = calloc(nb + 1, sizeof(double));
     s->Bb = calloc(nb + 1, sizeof(double));
     s->Bz = calloc(nb + 1, sizeof(double));
-    if (!s->nb_part || !s->Mz || !s->Bb || !s->Bz) {
+    if (o->pins) s->Az = calloc(nb + 1, sizeof(double));
+    if (!s->nb_part || !s->Mz || !s->Bb || !s->Bz || (o->pins && !s->Az)) {
         free(keys);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coefficient-space matrices");
     }
@@ -224,18 +226,19 @@ static double *block_of(const sem_structured_ops *s, double *D, int m, int a, in
     return D + (size_t)lo * m * m;
 }
 
-/* Mz, Bz from the pair blocks (n_pairs x m x m, own bases), Bb = sum_s a_s g_s^T g_s (samples
- * in order: each entry sums as the dense matrix did). */
+/* Mz, Bz, Az from the pair blocks (n_pairs x m x m, own bases), Bb = sum_s a_s g_s^T g_s
+ * (samples in order: each entry sums as the dense matrix did). */
 static void fill_blocks(const sem_object *o, sem_structured_ops *s, const double *Mz_pairs,
-                        const double *Bz_pairs)
+                        const double *Bz_pairs, const double *Az_pairs)
 {
     int m = o->m;
     for (int k = 0; k < o->n_pairs; ++k) {
         int a = o->pair_a[k], b = o->pair_b[k];
-        for (int t = 0; t < 2; ++t) {
-            const double *src = t ? Bz_pairs : Mz_pairs;
-            if (!src) continue;
-            double *blk = block_of(s, t ? s->Bz : s->Mz, m, a, b);
+        for (int t = 0; t < 3; ++t) {
+            const double *src = t == 2 ? Az_pairs : t ? Bz_pairs : Mz_pairs;
+            double *dst = t == 2 ? s->Az : t ? s->Bz : s->Mz;
+            if (!src || !dst) continue;
+            double *blk = block_of(s, dst, m, a, b);
             src += (size_t)k * m * m;
             for (int e = 0; e < m * m; ++e) blk[e] += src[e];
         }
@@ -252,7 +255,7 @@ static void fill_blocks(const sem_object *o, sem_structured_ops *s, const double
 }
 
 sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const double *Bz_pairs,
-                               int n_ties, const int *tie_ctrl, const int *tie_part,
+                               const double *Az_pairs, int n_ties, const int *tie_ctrl, const int *tie_part,
                                double tie_weight, double weld_weight, sem_error *err)
 {
     sem_structured_ops *s = calloc(1, sizeof *s);
@@ -263,7 +266,7 @@ sem_status sem_structured_init(sem_object *o, const double *Mz_pairs, const doub
     if (st == SEM_OK) st = build_samples(o, s, n_ties, tie_ctrl, tie_part, tie_weight, weld_weight, err);
     if (st == SEM_OK) st = build_neighbours(o, s, err);
     if (st != SEM_OK) return st;
-    fill_blocks(o, s, Mz_pairs, Bz_pairs);
+    fill_blocks(o, s, Mz_pairs, Bz_pairs, Az_pairs);
     o->K0z = malloc(((size_t)o->n_pairs * 9 * o->ma * o->ma + 1) * sizeof(double));
     if (!o->K0z)
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the coefficient-space matrices");
@@ -343,7 +346,7 @@ static void dense_multiply(const sem_object *o, const double *D, double c, const
 
 /* y += Kc x for Kc = cK K + cD K0 in the shared basis: z' = pi_shared x, per stored pair
  * (a <= b) out_a += Kc_ab z'_b and out_b += Kc_ab^T z'_a, then pi_shared^T out. */
-void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD,
+void sem_structured_multiply(const sem_object *o, double cM, double cE, double cK, double cD, double cA,
                              const double *x, double *y)
 {
     const sem_structured_ops *s = o->ops;
@@ -354,6 +357,7 @@ void sem_structured_multiply(const sem_object *o, double cM, double cE, double c
     double *oz = yz + 3 * (size_t)r0, *res = oz + 3 * (size_t)r0;
     apply_P(o, x, yz);
     if (cM != 0) dense_multiply(o, s->Mz, cM, yz, oz);
+    if (cA != 0 && s->Az) dense_multiply(o, s->Az, cA, yz, oz);
     if (cE != 0) {
         double c = 2.0 * cE;
         dense_multiply(o, s->Bz, c, yz, oz);

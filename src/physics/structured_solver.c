@@ -99,10 +99,10 @@ struct sem_structured_solver {
     /* the rest matrix's factor (integrators.c, "Reusing the rest factor"): C of the
      * coefficients rest_coef with K0 in place of K; rest_ok once made */
     double *C_rest;
-    double rest_coef[4];
+    double rest_coef[5];
     int rest_ok;
     const double *Cf; /* the factor the solves use: C, or C_rest while solving with it */
-    double coef[4];
+    double coef[5];
     double last_factor_s;
     double *work;
 };
@@ -674,7 +674,7 @@ sem_status sem_structured_solver_create(sem_object *o, sem_structured_solver **o
     return SEM_OK;
 }
 
-void sem_structured_solver_set(sem_structured_solver *s, const double c[4])
+void sem_structured_solver_set(sem_structured_solver *s, const double c[5])
 {
     memcpy(s->coef, c, sizeof s->coef);
 }
@@ -684,7 +684,7 @@ double sem_structured_solver_factor_seconds(const sem_structured_solver *s)
     return s->last_factor_s;
 }
 
-/* T += sign Z~/c with Z~/c = Bb + Bz + (cM Mz + cK Kz + cD K0z) / c reduced to the distinct
+/* T += sign Z~/c with Z~/c = Bb + Bz + (cM Mz + cA Az + cK Kz + cD K0z) / c reduced to the distinct
  * rows; T column-major with leading dimension ld, entry (3 rho + d) at offset off. */
 static void add_Z(sem_structured_solver *s, double *T, size_t ld, size_t off, double sign)
 {
@@ -692,6 +692,7 @@ static void add_Z(sem_structured_solver *s, double *T, size_t ld, size_t off, do
     const sem_structured_ops *ops = o->ops;
     int r0 = s->r0, m = o->m, M3 = 3 * m;
     double c = 2.0 * s->coef[1], cM = s->coef[0] / c, cK = s->coef[2] / c, cD = s->coef[3] / c;
+    double cA = ops->Az ? s->coef[4] / c : 0.0;
     /* scalar parts (the same for each coordinate; part-pair blocks, columns ascending);
      * duplicates add up, so serial */
     for (int a = 0; a < r0; ++a) {
@@ -701,6 +702,7 @@ static void add_Z(sem_structured_solver *s, double *T, size_t ld, size_t off, do
             size_t at = ((size_t)e * m + x) * m;
             for (int y = 0; y < m; ++y) {
                 double v = ops->Bb[at + y] + ops->Bz[at + y] + cM * ops->Mz[at + y];
+                if (cA != 0) v += cA * ops->Az[at + y];
                 if (v == 0) continue;
                 size_t ib = off + 3 * (size_t)s->red[ops->nb_part[e] * m + y];
                 for (int d = 0; d < 3; ++d) T[(ib + d) * ld + ia + d] += sign * v;
@@ -890,7 +892,7 @@ static void apply_A(sem_structured_solver *s, const double *x, double *y)
         if (f >= 0)
             for (int d = 0; d < 3; ++d) xf[3 * (size_t)c + d] = x[3 * (size_t)f + d];
     }
-    sem_structured_multiply(o, s->coef[0], s->coef[1], s->coef[2], s->coef[3], xf, yf);
+    sem_structured_multiply(o, s->coef[0], s->coef[1], s->coef[2], s->coef[3], s->coef[4], xf, yf);
     for (int c = 0; c < o->n_ctrl; ++c) {
         int f = o->free_index[c];
         if (f >= 0)
@@ -993,7 +995,7 @@ sem_status sem_structured_solver_solve(sem_structured_solver *s, const double *b
 
 sem_status sem_structured_solver_factorize_rest(sem_structured_solver *s, int *factored, sem_error *err)
 {
-    const double rc[4] = {s->coef[0], s->coef[1], 0.0, s->coef[2] + s->coef[3]};
+    const double rc[5] = {s->coef[0], s->coef[1], 0.0, s->coef[2] + s->coef[3], s->coef[4]};
     *factored = 0;
     if (s->rest_ok && memcmp(rc, s->rest_coef, sizeof rc) == 0) return SEM_OK;
     s->rest_ok = 0;
@@ -1001,7 +1003,7 @@ sem_status sem_structured_solver_factorize_rest(sem_structured_solver *s, int *f
     if (!s->C_rest && !(s->C_rest = malloc((N * N + 1) * sizeof(double))))
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the rest factor");
     /* factorize with K0 in place of K, then keep that factor apart */
-    double now[4];
+    double now[5];
     memcpy(now, s->coef, sizeof now);
     memcpy(s->coef, rc, sizeof rc);
     sem_status st = sem_structured_solver_factorize(s, err);

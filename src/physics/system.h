@@ -24,8 +24,8 @@
  * so filling the matrix is one pass over the blocks, group pair by group pair, in parallel.
  *
  * The system is the only part of the simulator that knows the linear solver: the
- * integrators fill c_M M + c_E 2 gamma M_eps + c_K K + c_D K0, factorize and solve through
- * it. A solver that exploits the matrix's structure (blocks per group plus a low-rank
+ * integrators fill c_M M + c_E 2 gamma M_eps + c_K K + c_D K0 + c_A A (A: the material pins'
+ * anchor, pins.h), factorize and solve through it. A solver that exploits the matrix's structure (blocks per group plus a low-rank
  * coupling through Pi) can replace CHOLMOD / LAPACK behind these calls alone.
  */
 #ifndef SEM_PHYSICS_SYSTEM_H
@@ -51,9 +51,9 @@ typedef struct sem_system {
     int **map;                 /* per object: per K block entry, position in the values or -1 */
     sem_linear_solver *solver; /* NULL when nothing is free (or structured) */
     /* the rest matrix's factor, kept for the run (integrators.c, "Reusing the rest
-     * factor"): same pattern as solver, values cM M + cE 2 gamma M_eps + cD K0 */
+     * factor"): same pattern as solver, values cM M + cE 2 gamma M_eps + cD K0 + cA A */
     sem_linear_solver *rest;
-    double rest_coef[3];
+    double rest_coef[4];
     int structured;            /* the objects' own structured solvers (structured.h) instead */
     struct sem_structured_solver **ssolver; /* per object, NULL when it has nothing free */
     double factor_s;           /* seconds of the last factorization (structured) */
@@ -68,7 +68,7 @@ typedef struct sem_system {
 typedef struct sem_fill_target {
     sem_system *system;
     int object;                /* index into system->objects */
-    double coef[4];            /* of M, 2 M_eps, K, K0 (see sem_system_fill_gpair) */
+    double coef[5];            /* of M, 2 M_eps, K, K0, A (see sem_system_fill_gpair) */
 } sem_fill_target;
 
 /* Numbers the object's free control points (free_index, n_free) from its pinned flags. */
@@ -86,13 +86,16 @@ int sem_system_find_coupling(const sem_system *s, int a, int ga, int b, int gb);
 void sem_system_destroy(sem_system *s);
 
 /* The solver's values of object k's group pair g: c[0] M + c[1] 2 M_eps + c[2] K + c[3] K0
- * (c[1] includes the object's gamma). Group pairs write distinct positions. */
-void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], double *val);
-/* All values: cM M + cE gamma_k 2 M_eps + cK K + cD K0 for every object k. */
-void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD);
-/* Structured systems: the matrix of object k is c[0] M + 2 c[1] M_eps + c[2] K + c[3] K0 with
- * its current K (sem_assemble_elastic records it this way when given a fill target). */
-void sem_system_set_object(sem_system *s, int k, const double c[4]);
+ * + c[4] A (c[1] includes the object's gamma; A the material pins' anchor, pins.h: a constant
+ * potential's Hessian, so c[4] is the coefficient a Hessian gets, h^2 in the linearly
+ * implicit step, 1 in Newton). Group pairs write distinct positions. */
+void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[5], double *val);
+/* All values: cM M + cE gamma_k 2 M_eps + cK K + cD K0 + cA A for every object k. */
+void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD, double cA);
+/* Structured systems: the matrix of object k is c[0] M + 2 c[1] M_eps + c[2] K + c[3] K0 +
+ * c[4] A with its current K (sem_assemble_elastic records it this way when given a fill
+ * target). */
+void sem_system_set_object(sem_system *s, int k, const double c[5]);
 /* The values to fill (NULL when nothing is free or the system is structured). */
 double *sem_system_values(sem_system *s);
 sem_status sem_system_factorize(sem_system *s, sem_error *err);
@@ -101,10 +104,10 @@ double sem_system_factor_seconds(const sem_system *s);
 /* x = A^-1 b over the free dofs (x may alias b). */
 sem_status sem_system_solve(sem_system *s, const double *b, double *x, sem_error *err);
 
-/* The factor of the rest matrix cM M + cE 2 gamma_k M_eps + cD K0 (q-space systems): made
- * the first time, and again only when the coefficients change; *factored says whether this
- * call factored. */
-sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, int *factored,
+/* The factor of the rest matrix cM M + cE 2 gamma_k M_eps + cD K0 + cA A (q-space systems):
+ * made the first time, and again only when the coefficients change; *factored says whether
+ * this call factored. */
+sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, double cA, int *factored,
                                     sem_error *err);
 double sem_system_rest_factor_seconds(const sem_system *s);
 /* x = R^-1 b with the rest factor alone (no refinement; the caller iterates). */

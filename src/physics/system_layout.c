@@ -321,7 +321,7 @@ void sem_system_destroy(sem_system *s)
     free(s);
 }
 
-void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], double *val)
+void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[5], double *val)
 {
     const sem_object *o = s->objects[k];
     if (o->gpair_a[g] > o->gpair_b[g]) return; /* mapped nowhere (see system.h) */
@@ -329,6 +329,7 @@ void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], doubl
     size_t off = o->gpair_offset[g];
     for (size_t la = 0; la < na; ++la) {
         const double *Ms = o->M_blocks + off + la * nb, *Es = o->E_blocks + off + la * nb;
+        const double *As = o->A_blocks && c[4] != 0 ? o->A_blocks + off + la * nb : NULL;
         for (int dd = 0; dd < 9; ++dd) {
             int diag = dd / 3 == dd % 3;
             size_t row = 9 * off + (la * 9 + (size_t)dd) * nb;
@@ -338,23 +339,23 @@ void sem_system_fill_gpair(sem_system *s, int k, int g, const double c[4], doubl
                 int pos = map[lb];
                 if (pos < 0) continue;
                 double v = c[2] * K[lb] + c[3] * K0[lb];
-                if (diag) v += c[0] * Ms[lb] + 2.0 * c[1] * Es[lb];
+                if (diag) v += c[0] * Ms[lb] + 2.0 * c[1] * Es[lb] + (As ? c[4] * As[lb] : 0.0);
                 val[pos] = v;
             }
         }
     }
 }
 
-void sem_system_set_object(sem_system *s, int k, const double c[4])
+void sem_system_set_object(sem_system *s, int k, const double c[5])
 {
     if (s->ssolver && s->ssolver[k]) sem_structured_solver_set(s->ssolver[k], c);
 }
 
-void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD)
+void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD, double cA)
 {
     if (s->structured) {
         for (int k = 0; k < s->n_objects; ++k) {
-            const double c[4] = {cM, cE * s->objects[k]->gamma, cK, cD};
+            const double c[5] = {cM, cE * s->objects[k]->gamma, cK, cD, cA};
             sem_system_set_object(s, k, c);
         }
         return;
@@ -362,17 +363,18 @@ void sem_system_fill(sem_system *s, double cM, double cE, double cK, double cD)
     double *val = sem_linear_solver_values(s->solver);
     for (int k = 0; k < s->n_objects; ++k) {
         const sem_object *o = s->objects[k];
-        const double c[4] = {cM, cE * o->gamma, cK, cD};
+        const double c[5] = {cM, cE * o->gamma, cK, cD, cA};
 #pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
         for (int g = 0; g < o->n_gpairs; ++g) sem_system_fill_gpair(s, k, g, c, val);
     }
 }
 
-sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, int *factored,
+sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double cD, double cA, int *factored,
                                     sem_error *err)
 {
     *factored = 0;
-    if (s->rest && s->rest_coef[0] == cM && s->rest_coef[1] == cE && s->rest_coef[2] == cD) return SEM_OK;
+    if (s->rest && s->rest_coef[0] == cM && s->rest_coef[1] == cE && s->rest_coef[2] == cD && s->rest_coef[3] == cA)
+        return SEM_OK;
     if (!s->rest) {
         sem_status st = sem_linear_solver_clone_pattern(s->solver, &s->rest, err);
         if (st != SEM_OK) return st;
@@ -380,7 +382,7 @@ sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double
     double *val = sem_linear_solver_values(s->rest);
     for (int k = 0; k < s->n_objects; ++k) {
         const sem_object *o = s->objects[k];
-        const double c[4] = {cM, cE * o->gamma, 0.0, cD};
+        const double c[5] = {cM, cE * o->gamma, 0.0, cD, cA};
 #pragma omp parallel for schedule(dynamic, 8) num_threads(o->nthreads)
         for (int g = 0; g < o->n_gpairs; ++g) sem_system_fill_gpair(s, k, g, c, val);
     }
@@ -390,6 +392,7 @@ sem_status sem_system_factorize_rest(sem_system *s, double cM, double cE, double
     s->rest_coef[0] = cM;
     s->rest_coef[1] = cE;
     s->rest_coef[2] = cD;
+    s->rest_coef[3] = cA;
     *factored = 1;
     return SEM_OK;
 }

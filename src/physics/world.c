@@ -7,6 +7,7 @@
  *   object.h         an object and the block structure of its matrices (object_layout.c)
  *   assembly.h       its elastic terms (assembly.c), mass and error matrices (mass_error.c)
  *   loads.h          gravity, region and point loads, prescribed motion (loads.c)
+ *   pins.h           material pins: the material of a box held (pins.c)
  *   system.h         free dofs, the sparse system of a set of objects, solves
  *                    (system_layout.c over linear_solver.c)
  *   integrators.h    linearly implicit Euler (integrators.c), Newton for implicit Euler
@@ -25,6 +26,7 @@
 #include "input_scales.h"
 #include "runaway.h"
 #include "loads.h"
+#include "pins.h"
 #include "system.h"
 #include "sem/limits.h"
 #include "structured.h"
@@ -130,6 +132,8 @@ static void object_destroy(sem_object *o)
     free(o->me_M);
     free(o->me_E);
     free(o->K0_blocks);
+    free(o->A_blocks);
+    sem_pins_free(o);
     free(o->K0z);
     free(o->point_H);
     free(o->point_H0);
@@ -208,6 +212,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->def.prescribes = NULL;
     o->def.point_loads = NULL;
     o->def.region_loads = NULL;
+    o->def.pin_regions = NULL; /* pins.c keeps what it needs */
     o->def.n_point_loads = 0;
     o->def.n_region_loads = 0;
     o->d = d;
@@ -285,6 +290,8 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
     o->nthreads = w->def.threads > 0 ? w->def.threads : omp_get_max_threads();
     if (def->weld && (st = sem_object_find_welds(o, err)) != SEM_OK) goto fail;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
+    /* material pins (before the constant matrices, which take their anchor) */
+    if ((st = sem_pins_init(o, def, err)) != SEM_OK) goto fail;
     if ((st = sem_assembly_init(o, w->def.advanced.assembly_chunk, err)) != SEM_OK) goto fail;
     if ((st = sem_mass_error_init(o, err)) != SEM_OK) goto fail;
     o->grad_z_share =
@@ -535,7 +542,7 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
     if (o->mass > 0)
         for (int k = 0; k < 3; ++k) s->center_of_mass[k] /= o->mass;
     /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
-    sem_blocks_multiply(o, 1.0, 0, 0, 0, o->v, tmp);
+    sem_blocks_multiply(o, 1.0, 0, 0, 0, 0, o->v, tmp);
     for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
     s->error_energy = sem_error_energy(o, o->q, tmp);
     sem_error e;

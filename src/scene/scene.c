@@ -426,11 +426,13 @@ static sem_status parse_prescription(ctx *c, const cJSON *pr, const char *w, sem
         return SEM_OK;
 }
 
-/* A control point selection {box, parts, points}. */
+/* A pin selection {box, control_box, parts, points}: box the material in it (material pin,
+ * sem_pin_region), the rest control points. */
 static sem_status parse_selection(ctx *c, const cJSON *pin, const char *w, int *has_box, double box[6],
-                                  int **parts, int *n_parts, int **points, int *n_points)
+                                  int *has_control_box, double control_box[6], int **parts, int *n_parts,
+                                  int **points, int *n_points)
 {
-    static const char *const pkeys[] = {"box", "parts", "points", NULL};
+    static const char *const pkeys[] = {"box", "control_box", "parts", "points", NULL};
     sem_status st = check_keys(c, pin, w, pkeys);
     if (st != SEM_OK) return st;
     char w2[320];
@@ -439,6 +441,12 @@ static sem_status parse_selection(ctx *c, const cJSON *pin, const char *w, int *
         snprintf(w2, sizeof w2, "%s.box", w);
         if ((st = get_box(c, b, w2, box)) != SEM_OK) return st;
         *has_box = 1;
+    }
+    const cJSON *cb = cJSON_GetObjectItemCaseSensitive(pin, "control_box");
+    if (cb) {
+        snprintf(w2, sizeof w2, "%s.control_box", w);
+        if ((st = get_box(c, cb, w2, control_box)) != SEM_OK) return st;
+        *has_control_box = 1;
     }
     const cJSON *pp = cJSON_GetObjectItemCaseSensitive(pin, "parts");
     if (pp) {
@@ -450,7 +458,7 @@ static sem_status parse_selection(ctx *c, const cJSON *pin, const char *w, int *
         snprintf(w2, sizeof w2, "%s.points", w);
         if ((st = parse_int_list(c, pt, w2, points, n_points)) != SEM_OK) return st;
     }
-    if (!b && !pp && !pt) return fail(c, w, "selects nothing (give box, parts or points)");
+    if (!b && !cb && !pp && !pt) return fail(c, w, "selects nothing (give box, control_box, parts or points)");
     return SEM_OK;
 }
 
@@ -653,26 +661,11 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     }
     const cJSON *pin = cJSON_GetObjectItemCaseSensitive(o, "pin");
     if (pin) {
-        static const char *const pkeys[] = {"box", "parts", "points", NULL};
         snprintf(w, sizeof w, "%s.pin", where);
-        if ((st = check_keys(c, pin, w, pkeys)) != SEM_OK) return st;
-        const cJSON *b = cJSON_GetObjectItemCaseSensitive(pin, "box");
-        char w2[300];
-        if (b) {
-            snprintf(w2, sizeof w2, "%s.box", w);
-            if ((st = get_box(c, b, w2, obj->pin_box)) != SEM_OK) return st;
-            obj->has_pin_box = 1;
-        }
-        const cJSON *pp = cJSON_GetObjectItemCaseSensitive(pin, "parts");
-        if (pp) {
-            snprintf(w2, sizeof w2, "%s.parts", w);
-            if ((st = parse_int_list(c, pp, w2, &obj->pin_parts, &obj->n_pin_parts)) != SEM_OK) return st;
-        }
-        const cJSON *pt = cJSON_GetObjectItemCaseSensitive(pin, "points");
-        if (pt) {
-            snprintf(w2, sizeof w2, "%s.points", w);
-            if ((st = parse_int_list(c, pt, w2, &obj->pin_points, &obj->n_pin_points)) != SEM_OK) return st;
-        }
+        if ((st = parse_selection(c, pin, w, &obj->has_pin_box, obj->pin_box, &obj->has_pin_control_box,
+                                  obj->pin_control_box, &obj->pin_parts, &obj->n_pin_parts, &obj->pin_points,
+                                  &obj->n_pin_points)) != SEM_OK)
+            return st;
     }
     const cJSON *pr = cJSON_GetObjectItemCaseSensitive(o, "prescribe");
     if (pr && cJSON_IsArray(pr)) {
@@ -693,8 +686,8 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             const cJSON *gp = cJSON_GetObjectItemCaseSensitive(it, "pin");
             if (!gp) return fail(c, w2, "needs \"pin\" (which control points follow this motion)");
             snprintf(w3, sizeof w3, "%s.pin", w2);
-            if ((st = parse_selection(c, gp, w3, &gr->has_box, gr->box, &gr->parts, &gr->n_parts, &gr->points,
-                                      &gr->n_points)) != SEM_OK)
+            if ((st = parse_selection(c, gp, w3, &gr->has_box, gr->box, &gr->has_control_box, gr->control_box,
+                                      &gr->parts, &gr->n_parts, &gr->points, &gr->n_points)) != SEM_OK)
                 return st;
             if ((st = parse_prescription(c, it, w2, &gr->prescribe)) != SEM_OK) return st;
             if (gr->prescribe.type == SEM_PRESCRIBE_NONE) return fail(c, w2, "needs \"affine\" or \"rotate\"");
@@ -705,10 +698,10 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         if ((st = check_keys(c, pr, w, pkeys)) != SEM_OK) return st;
         if ((st = parse_prescription(c, pr, w, &obj->prescribe)) != SEM_OK) return st;
     }
-    if (obj->prescribe.type != SEM_PRESCRIBE_NONE && !obj->has_pin_box && obj->n_pin_parts == 0 &&
-        obj->n_pin_points == 0) {
+    if (obj->prescribe.type != SEM_PRESCRIBE_NONE && !obj->has_pin_box && !obj->has_pin_control_box &&
+        obj->n_pin_parts == 0 && obj->n_pin_points == 0) {
         snprintf(w, sizeof w, "%s.prescribe", where);
-        return fail(c, w, "moves the pinned control points, but the object has no \"pin\"");
+        return fail(c, w, "moves what is pinned, but the object has no \"pin\"");
     }
     if ((st = get_vec(c, o, "initial_velocity", where, 3, obj->initial_velocity)) != SEM_OK) return st;
     if ((st = get_vec(c, o, "initial_angular_velocity", where, 3, obj->initial_angular_velocity)) != SEM_OK)
@@ -1376,7 +1369,7 @@ sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, 
 {
     size_t n = sem_model_control_points(m);
     *out = NULL;
-    if (!o->has_pin_box && o->n_pin_parts == 0 && o->n_pin_points == 0) return SEM_OK;
+    if (!o->has_pin_control_box && o->n_pin_parts == 0 && o->n_pin_points == 0) return SEM_OK;
     unsigned char *pin = calloc(n + 1, 1);
     if (!pin) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     size_t *off = malloc(((size_t)m->n_parts + 1) * sizeof(size_t));
@@ -1391,8 +1384,9 @@ sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, 
         for (int k = 0; k < o->n_pin_parts; ++k) whole |= o->pin_parts[k] == i;
         for (int c = 0; c < s->n_u * s->n_v; ++c) {
             const double *x = s->ctrl + 3 * c;
-            int in = o->has_pin_box && x[0] >= o->pin_box[0] && x[1] >= o->pin_box[1] && x[2] >= o->pin_box[2] &&
-                     x[0] <= o->pin_box[3] && x[1] <= o->pin_box[4] && x[2] <= o->pin_box[5];
+            const double *b = o->pin_control_box;
+            int in = o->has_pin_control_box && x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] &&
+                     x[1] <= b[4] && x[2] <= b[5];
             if (in || whole) pin[off[i] + (size_t)c] = 1;
         }
     }
@@ -1417,15 +1411,38 @@ sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, 
     for (size_t c = 0; c < n; ++c) count += pin[c];
     if (count == 0) {
         free(pin);
-        if (o->has_pin_box)
+        if (o->has_pin_control_box)
             return sem_error_set(err, SEM_ERR_INVALID,
-                                 "pin.box: [[%g, %g, %g], [%g, %g, %g]] contains no control point of the model "
-                                 "(after its transform)",
-                                 o->pin_box[0], o->pin_box[1], o->pin_box[2], o->pin_box[3], o->pin_box[4],
-                                 o->pin_box[5]);
+                                 "pin.control_box: [[%g, %g, %g], [%g, %g, %g]] contains no control point of the "
+                                 "model (after its transform)",
+                                 o->pin_control_box[0], o->pin_control_box[1], o->pin_control_box[2],
+                                 o->pin_control_box[3], o->pin_control_box[4], o->pin_control_box[5]);
         return sem_error_set(err, SEM_ERR_INVALID, "pin: selects no control point of the model");
     }
     *out = pin;
+    return SEM_OK;
+}
+
+sem_status sem_scene_object_pin_regions(const sem_scene_object *o, sem_pin_region **out, int *n, sem_error *err)
+{
+    *out = NULL;
+    *n = 0;
+    int count = o->has_pin_box;
+    for (int g = 0; g < o->n_prescribe_groups; ++g) count += o->prescribe_groups[g].has_box;
+    if (count == 0) return SEM_OK;
+    sem_pin_region *r = calloc((size_t)count, sizeof *r);
+    if (!r) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    if (o->has_pin_box) {
+        memcpy(r[*n].box, o->pin_box, sizeof r[*n].box);
+        /* the object's own pin follows its single "prescribe"; with prescribe groups it stays */
+        r[(*n)++].prescribe = o->n_prescribe_groups == 0 && o->prescribe.type != SEM_PRESCRIBE_NONE ? 0 : -1;
+    }
+    for (int g = 0; g < o->n_prescribe_groups; ++g) {
+        if (!o->prescribe_groups[g].has_box) continue;
+        memcpy(r[*n].box, o->prescribe_groups[g].box, sizeof r[*n].box);
+        r[(*n)++].prescribe = g;
+    }
+    *out = r;
     return SEM_OK;
 }
 
@@ -1506,8 +1523,9 @@ sem_status sem_scene_object_prescribe_groups(const sem_scene_object *o, const se
             for (int k = 0; k < gr->n_parts; ++k) whole |= gr->parts[k] == i;
             for (int c = 0; c < s->n_u * s->n_v; ++c) {
                 const double *x = s->ctrl + 3 * c;
-                int in = gr->has_box && x[0] >= gr->box[0] && x[1] >= gr->box[1] && x[2] >= gr->box[2] &&
-                         x[0] <= gr->box[3] && x[1] <= gr->box[4] && x[2] <= gr->box[5];
+                const double *b = gr->control_box;
+                int in = gr->has_control_box && x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] &&
+                         x[1] <= b[4] && x[2] <= b[5];
                 if (in || whole) {
                     group[off[i] + (size_t)c] = g;
                     count++;
@@ -1518,7 +1536,9 @@ sem_status sem_scene_object_prescribe_groups(const sem_scene_object *o, const se
             group[gr->points[k]] = g;
             count++;
         }
-        if (count == 0) {
+        /* (a group whose only selection is a material box moves no control point: the box's
+         * material is checked against the discretization, sem_scene_object_pin_regions) */
+        if (count == 0 && !gr->has_box) {
             free(group);
             free(off);
             return sem_error_set(err, SEM_ERR_INVALID, "prescribe[%d].pin: selects no control point of the model", g);

@@ -426,6 +426,49 @@ static sem_status patch_object(const sem_scene_object *so, const sem_patches *p,
     return SEM_OK;
 }
 
+/* Whether any of the discretization's material points - quadrature points, boundary samples -
+ * lies in box at rest (what a material pin holds, sem_pin_region). */
+static int material_in_box(const sem_discretization *d, const double b[6])
+{
+    for (int t = 0; t < 2; ++t) {
+        const double *X = t ? d->sample_X : d->quad_X;
+        int n = t ? d->n_samples : d->n_quad;
+        for (int k = 0; k < n; ++k, X += 3)
+            if (X[0] >= b[0] && X[1] >= b[1] && X[2] >= b[2] && X[0] <= b[3] && X[1] <= b[4] && X[2] <= b[5])
+                return 1;
+    }
+    return 0;
+}
+
+/* The object's material pins (sem_scene_object_pin_regions), each checked to hold some
+ * material, so that the error names its key. */
+static sem_status pin_regions(const sem_scene_object *so, const sem_discretization *d, sem_pin_region **out, int *n,
+                              sem_error *err)
+{
+    sem_status st = sem_scene_object_pin_regions(so, out, n, err);
+    if (st != SEM_OK) return st;
+    int r = 0;
+    for (int g = -1; g < so->n_prescribe_groups; ++g) {
+        if (!(g < 0 ? so->has_pin_box : so->prescribe_groups[g].has_box)) continue;
+        double b[6];
+        memcpy(b, (*out)[r++].box, sizeof b);
+        if (material_in_box(d, b)) continue;
+        char key[64];
+        if (g < 0)
+            snprintf(key, sizeof key, "pin.box");
+        else
+            snprintf(key, sizeof key, "prescribe[%d].pin.box", g);
+        free(*out);
+        *out = NULL;
+        *n = 0;
+        return sem_error_set(err, SEM_ERR_INVALID,
+                             "%s: [[%g, %g, %g], [%g, %g, %g]] holds none of the model's material (no quadrature "
+                             "point or boundary sample lies in it, after its transform)",
+                             key, b[0], b[1], b[2], b[3], b[4], b[5]);
+    }
+    return SEM_OK;
+}
+
 /* Adds object i (preprocessed by prepare_object) to the world. */
 static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_options *o,
                              sem_error *err)
@@ -444,10 +487,14 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
         }
         so = &po.o;
     }
+    sem_pin_region *regions = NULL;
+    int n_regions = 0;
     if ((st = sem_scene_object_pins(so, model, &sw->pins[i], err)) != SEM_OK ||
+        (st = pin_regions(so, sw->discs[i], &regions, &n_regions, err)) != SEM_OK ||
         (st = sem_scene_object_part_materials(so, model, &sw->part_material[i], &sw->materials[i],
                                               err)) != SEM_OK ||
         (st = sem_scene_object_prescribe_groups(so, model, &sw->prescribe_group[i], err)) != SEM_OK) {
+        free(regions);
         release(&po);
         return prefix_error(err, st, name, i, ".");
     }
@@ -467,6 +514,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     if (sw->prescribe_group[i]) {
         sw->prescribes[i] = malloc((size_t)so->n_prescribe_groups * sizeof(sem_prescribe));
         if (!sw->prescribes[i]) {
+            free(regions);
             release(&po);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
@@ -484,7 +532,10 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.region_loads = so->region_loads;
     od.n_region_loads = so->n_region_loads;
     od.friction = so->friction;
+    od.pin_regions = regions; /* copied by the world */
+    od.n_pin_regions = n_regions;
     int id = sem_world_add_object(sw->world, &od, err);
+    free(regions);
     release(&po);
     if (id < 0) return prefix_error(err, err ? err->status : SEM_ERR_INVALID, name, i, ": ");
     warn_tied_points(sw, i, id, o);

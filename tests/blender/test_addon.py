@@ -478,7 +478,7 @@ parts_b[2].location = (0, 0, 0)
 b.pin_mode = "BOX"
 b.pin_box_min, b.pin_box_max = (5.0, 5.0, 5.0), (6.0, 6.0, 6.0)
 expect_error("pin box holding nothing",
-             "sem: failed: %s: pin.box: [[5, 5, 5], [6, 6, 6]] contains no control point"
+             "sem: failed: %s: pin.box: [[5, 5, 5], [6, 6, 6]] holds none of the model's material"
              % root_b.name, lambda: bpy.ops.sem.simulate())  # sem's message, in Blender's words
 b.pin_mode = "VERTEX_GROUP"
 root_b.sem.simulate = False
