@@ -68,6 +68,9 @@ typedef struct column_buffers {
     double *volume, *moment; /* cap_cells, 3 cap_cells: the midpoint rule's */
     double *second;          /* 6 cap_cells: xx yy zz xy xz yz, about the column origin */
     double *dvolume, *dmoment; /* cap_cells, 3 cap_cells: its corrections (quadrature_subrays.c) */
+    double *base_volume;     /* cap_cells: the volume the base rays alone find */
+    int *part;               /* cap_cells: material, -1 for none */
+    unsigned char *keep;     /* cap_cells: gets a point */
     int *offset;             /* cells along + 1 */
     int n_entries, cap_entries;
     cell_entry *entries;
@@ -197,11 +200,21 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
     double *dm = realloc(b->dmoment, 3 * cap * sizeof *dm);
     if (!dm) return 0;
     b->dmoment = dm;
+    double *bv = realloc(b->base_volume, cap * sizeof *bv);
+    if (!bv) return 0;
+    b->base_volume = bv;
+    int *cp = realloc(b->part, cap * sizeof *cp);
+    if (!cp) return 0;
+    b->part = cp;
+    unsigned char *kp = realloc(b->keep, cap);
+    if (!kp) return 0;
+    b->keep = kp;
     memset(b->volume, 0, (size_t)n_cells * sizeof *b->volume);
     memset(b->moment, 0, 3 * (size_t)n_cells * sizeof *b->moment);
     memset(b->second, 0, 6 * (size_t)n_cells * sizeof *b->second);
     memset(b->dvolume, 0, (size_t)n_cells * sizeof *b->dvolume);
     memset(b->dmoment, 0, 3 * (size_t)n_cells * sizeof *b->dmoment);
+    memset(b->base_volume, 0, (size_t)n_cells * sizeof *b->base_volume);
     b->n_entries = 0;
 
     const double h0 = g->h[0];
@@ -210,10 +223,12 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
     double col_origin[3]; /* moments about the column's corner: small numbers, no cancellation */
     for (int e = 0; e < 3; ++e)
         col_origin[e] = g->origin[e] + g->lo[0] * g->axis[0][e] + s1 * g->axis[1][e] + s2 * g->axis[2][e];
-    /* the leaves in node order: a fixed order, so fixed sums */
+    /* the leaves in node order: a fixed order, so fixed sums; the base rays (level 0, split
+     * or not) also say which cells get a point */
     for (int nd = 0; nd < rays->n_nodes; ++nd) {
         const sem_subray_node *node = &rays->nodes[nd];
-        if (node->child >= 0) continue;
+        const int leaf = node->child < 0, base = node->level == 0;
+        if (!leaf && !base) continue;
         const int R = rays->base << node->level;
         const double sy = g->h[1] / R, sz = g->h[2] / R, area = sy * sz;
         const double cb = s1 + (node->i + 0.5) * sy, cc = s2 + (node->j + 0.5) * sz;
@@ -235,6 +250,8 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
                     if (!(t1 > t0)) continue;
                     int cell = b->offset[k] + (a * ns + bi) * ns + ci;
                     double vol = (t1 - t0) * area, tm = 0.5 * (t0 + t1);
+                    if (base) b->base_volume[cell] += vol;
+                    if (!leaf) continue;
                     b->volume[cell] += vol;
                     double x[3];
                     for (int e = 0; e < 3; ++e) {
@@ -252,6 +269,7 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
                     if (!push_entry(b, cell, seg->part, t1 - t0)) return 0;
                 }
             }
+            if (!leaf) continue;
             if (seg->dv0 != 0.0)
                 add_correction(b, g, lev, origin, col_origin, node->i, node->j, R, seg->t0, seg->dv0);
             if (seg->dv1 != 0.0)
@@ -260,25 +278,76 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
     }
     /* each cell's material: the part with the longest inside length (entries summed) */
     if (b->n_entries > 0) qsort(b->entries, (size_t)b->n_entries, sizeof *b->entries, entry_cmp);
-    int cap_points = 0, e = 0;
+    int e = 0;
+    for (int cell = 0; cell < n_cells; ++cell) {
+        int part = -1;
+        double best = -1;
+        while (e < b->n_entries && b->entries[e].cell < cell) ++e;
+        while (e < b->n_entries && b->entries[e].cell == cell) {
+            int p = b->entries[e].part;
+            double len = 0;
+            while (e < b->n_entries && b->entries[e].cell == cell && b->entries[e].part == p)
+                len += b->entries[e++].len;
+            if (len > best) {
+                best = len;
+                part = p;
+            }
+        }
+        b->part[cell] = part;
+    }
+    /* The points are the cells the base rays find inside, as the midpoint rule of those rays
+     * alone had them: the finer rays sharpen volumes and centroids but add no point. Volume
+     * they find in a cell the base rays missed (a sliver at a silhouette, a corner of a small
+     * part) joins the kept cell of the column whose centroid is nearest, so the volume and
+     * its first moment stay whole; a sliver point of its own would carry almost no volume
+     * and could leave a small part owning one or two such points, too few to hold its
+     * polynomial (mugs/mug.iges, part 0), where before it was blended into its neighbours.
+     * Only a column without any kept cell keeps its slivers as points. */
+    int n_keep = 0;
     for (int k = 0; k < n0; ++k) {
         const double cell_volume = h0 * g->h[1] * g->h[2] / (double)(1 << (3 * lev[k]));
         for (int cell = b->offset[k]; cell < b->offset[k + 1]; ++cell) {
-            int part = -1;
-            double best = -1;
-            while (e < b->n_entries && b->entries[e].cell < cell) ++e;
-            while (e < b->n_entries && b->entries[e].cell == cell) {
-                int p = b->entries[e].part;
-                double len = 0;
-                while (e < b->n_entries && b->entries[e].cell == cell && b->entries[e].part == p)
-                    len += b->entries[e++].len;
-                if (len > best) {
-                    best = len;
-                    part = p;
+            b->keep[cell] = b->base_volume[cell] > MIN_CELL_FRACTION * cell_volume &&
+                            b->volume[cell] > 0 && b->part[cell] >= 0;
+            n_keep += b->keep[cell];
+        }
+    }
+    for (int k = 0; k < n0 && n_keep > 0; ++k) {
+        const double cell_volume = h0 * g->h[1] * g->h[2] / (double)(1 << (3 * lev[k]));
+        for (int cell = b->offset[k]; cell < b->offset[k + 1]; ++cell) {
+            if (b->keep[cell] || !(b->volume[cell] > MIN_CELL_FRACTION * cell_volume)) continue;
+            const double *m = b->moment + 3 * (size_t)cell;
+            const double V = b->volume[cell];
+            int target = -1;
+            double best = INFINITY;
+            for (int other = 0; other < n_cells; ++other) {
+                if (!b->keep[other]) continue;
+                const double *mo = b->moment + 3 * (size_t)other, Vo = b->volume[other];
+                double d2 = 0;
+                for (int d = 0; d < 3; ++d) d2 += (mo[d] / Vo - m[d] / V) * (mo[d] / Vo - m[d] / V);
+                if (d2 < best) {
+                    best = d2;
+                    target = other;
                 }
             }
+            b->volume[target] += b->volume[cell];
+            b->dvolume[target] += b->dvolume[cell];
+            for (int d = 0; d < 3; ++d) {
+                b->moment[3 * (size_t)target + d] += b->moment[3 * (size_t)cell + d];
+                b->dmoment[3 * (size_t)target + d] += b->dmoment[3 * (size_t)cell + d];
+            }
+            for (int d = 0; d < 6; ++d) b->second[6 * (size_t)target + d] += b->second[6 * (size_t)cell + d];
+            b->volume[cell] = 0;
+        }
+    }
+    int cap_points = 0;
+    for (int k = 0; k < n0; ++k) {
+        const double cell_volume = h0 * g->h[1] * g->h[2] / (double)(1 << (3 * lev[k]));
+        for (int cell = b->offset[k]; cell < b->offset[k + 1]; ++cell) {
             const double V0 = b->volume[cell], dV = b->dvolume[cell];
-            if (!(V0 > MIN_CELL_FRACTION * cell_volume) || part < 0) continue;
+            if (!(n_keep > 0 ? b->keep[cell] : V0 > MIN_CELL_FRACTION * cell_volume) ||
+                b->part[cell] < 0)
+                continue;
             /* the correction of a sliver can exceed the sliver (it is a term of an expansion
              * over the whole square): there keep the midpoint rule */
             const int corrected = fabs(dV) <= CORRECTION_LIMIT * V0;
@@ -286,7 +355,8 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
             double c[3];
             for (int d = 0; d < 3; ++d)
                 c[d] = (b->moment[3 * (size_t)cell + d] + (corrected ? b->dmoment[3 * (size_t)cell + d] : 0.0)) / V;
-            if (!emit_cell(b, cell, col_origin, cbrt(cell_volume), V, c, part, result, &cap_points))
+            if (!emit_cell(b, cell, col_origin, cbrt(cell_volume), V, c, b->part[cell], result,
+                           &cap_points))
                 return 0;
         }
     }
@@ -451,6 +521,9 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
         free(b.second);
         free(b.dvolume);
         free(b.dmoment);
+        free(b.base_volume);
+        free(b.part);
+        free(b.keep);
         free(b.entries);
     }
     if (n_rays)
