@@ -479,6 +479,7 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
     memcpy(rg.n, g.n, sizeof rg.n);
     rg.pad = g.pad;
     rg.length = g.length;
+    rg.subrays = SUBRAYS;
     int *base = malloc((size_t)n_columns * sizeof *base);
     sem_ray_points *cols = calloc((size_t)n_columns, sizeof *cols);
     if (!cols || !base) {

@@ -25,11 +25,19 @@
  *      |n . d| > ROUGH (s |Hess g| |n . d| ~ s / distance to the silhouette, i.e. where the
  *      Taylor expansion behind 1. fails), or whose derivatives are unknown (Newton did not
  *      converge onto the NURBS, a seam where parts meet, a ray in the tangent plane);
- *    - a neighbour (8 around, the same size, looked up across columns) whose signature
- *      differs: the number of crossings and which segments are inside. A silhouette, a wall
- *      along the rays, a hole or a trim edge lies between them; the miss side of a silhouette
- *      is found only this way.
- *    A rough crossing gets no correction (plain midpoint rule) even at the last level.
+ *    - a neighbour (8 around, the same size, looked up across columns) with another number
+ *      of inside intervals (of the union: crossings of overlapping solids inside it change
+ *      nothing). A silhouette, a wall along the rays, a hole or a trim edge lies between
+ *      them. At the base level every such square is split once; below it only next to a
+ *      rough crossing, i.e. the miss side of a silhouette, which only this finds. A wall's
+ *      squares are only counted in or out, so halving them again gains little (the cylinder
+ *      along its axis stays 0.59 % off; splitting its wall squares to the last level too gave
+ *      0.27 % for 2 x the rays) while complex models have many (the astronaut: 5.6 x the rays
+ *      and 9 x the time, since its refined rays cross the surface closely, where the winding
+ *      numbers of quadrature.c's vetoes are expensive).
+ *    A rough crossing gets no correction (plain midpoint rule) even at the last level. Squares
+ *    end at SUBRAYS << MAX_DEPTH per base cell: columns refined for a small part have that
+ *    many from the start.
  * Levels are global: every column's squares of one level are judged (reading the
  * neighbouring columns' squares of that level and coarser ones) before any is split, so the
  * result does not depend on the order or the threads that do it. A box whose faces lie on the
@@ -37,13 +45,14 @@
  * square is refined and its volume stays exact.
  *
  * Measured at the default grids (docs/validation.md section 4; bench/study_volume --defaults):
- * sphere 0.79 % -> 0.063 %, torus 0.71 % -> 0.054 %, rounded_cube.iges 0.56 % -> 0.052 %,
- * with 5.9, 5.1 and 4.8 times the rays and the same points (the rounded cube 198 for 194). The
- * correction alone (MAX_DEPTH 0) gives 0.51 %, 0.55 %, 0.51 %; a third level 0.007 %, 0.023 %,
- * 0.064 % for twice the rays again. What is left: kinks of the inside length where parts meet
- * at an angle (rounded_cube.iges), and walls along the rays, whose squares are only counted
- * in or out (the cylinder along its axis: 0.59 % -> 0.27 %, of which -0.16 % is the
- * tessellation's polygon that the caps' rays must hit).
+ * sphere 0.79 % -> 0.061 %, torus 0.71 % -> 0.043 %, rounded_cube.iges 0.56 % -> 0.056 %,
+ * mug_trimmed_complex.iges 0.67 % -> 0.005 % (against fine grids along x, y, z, which differ by
+ * 0.13 %), with 5.1, 4.5, 4.3 and 1.9 times the rays and the same points (the rounded cube 198
+ * for 194). The correction alone (MAX_DEPTH 0) gives 0.34 %, 0.49 %, 0.50 %; a third level
+ * 0.017 %, 0.006 %, 0.056 % for twice the rays again. What is left: kinks of the inside length
+ * where parts meet at an angle (rounded_cube.iges), and walls along the rays; and the
+ * tessellation, whose polygon the rays must hit before they reach the exact surface (-0.16 %
+ * on the cylinder's caps).
  */
 #include "quadrature_subrays.h"
 
@@ -133,14 +142,14 @@ static int cast(const sem_raycast_scene *scene, const sem_subray_grid *g,
     node->seg_begin = col->n_seg;
     node->n_seg = 0;
     node->rough = 0;
-    unsigned signature = (unsigned)n_hits;
+    unsigned intervals = 0;
     int ok = 1;
     for (int q = 0; q < n_seg; ++q) {
-        signature = signature * 31u + (unsigned)(seg[q].inside != 0);
         if (!seg[q].inside || !(seg[q].t1 > seg[q].t0)) continue;
         /* segment q runs from hit q - 1 to hit q; an end shared with another inside segment
          * is no boundary of the union */
         int entry = q >= 1 && !(seg[q - 1].inside && seg[q - 1].t1 > seg[q - 1].t0);
+        intervals += !(q >= 1 && seg[q - 1].inside && seg[q - 1].t1 > seg[q - 1].t0);
         int exit = q < n_hits && !(q + 1 < n_seg && seg[q + 1].inside && seg[q + 1].t1 > seg[q + 1].t0);
         double dv0 = 0, dv1 = 0;
         if (entry) dv0 = end_correction(scene, g, st, &hits[q - 1], sy, sz, -1.0, &node->rough);
@@ -152,7 +161,7 @@ static int cast(const sem_raycast_scene *scene, const sem_subray_grid *g,
         col->seg[col->n_seg++] = (sem_subray_segment){seg[q].t0, seg[q].t1, seg[q].part, dv0, dv1};
         node->n_seg++;
     }
-    node->signature = signature;
+    node->signature = intervals;
     free(seg);
     free(hits);
     return ok;
@@ -198,7 +207,8 @@ static int wants_split(const sem_subray_grid *g, const sem_subray_column *cols, 
         for (int z = -1; z <= 1; ++z) {
             if (!y && !z) continue;
             const sem_subray_node *other = leaf_at(g, cols, b + y * db, c + z * dc);
-            if (other && other->signature != node->signature) return 1;
+            if (other && other->signature != node->signature && (node->level == 0 || other->rough))
+                return 1;
         }
     return 0;
 }
@@ -256,9 +266,12 @@ sem_status sem_subrays_cast(const sem_raycast_scene *scene, const sem_subray_gri
                 failed |= 1;
                 continue;
             }
+            /* squares no finer than subrays << depth per base cell: a column refined for a
+             * small part (base subrays << L) has that many already when L = depth */
+            const int may_split = (col->base << (level + 1)) <= (g->subrays << depth);
             for (int k = 0; k < m; ++k)
-                split[c][k] = (unsigned char)wants_split(g, cols, c % g->n[1], c / g->n[1],
-                                                          col->level_begin + k);
+                split[c][k] = may_split && wants_split(g, cols, c % g->n[1], c / g->n[1],
+                                                       col->level_begin + k);
         }
         if (failed) break;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)

@@ -15,6 +15,7 @@ typedef struct sem_subray_grid {
     double lo[3], h[3];
     int n[3];
     double pad, length;
+    int subrays; /* squares per direction of a base cell at level 0 without small parts */
 } sem_subray_grid;
 
 /* An inside piece of one ray: [t0, t1] along it, the part whose material it takes, and the
