@@ -13,7 +13,8 @@
  * does not depend on it: each interval is integrated exactly in its length).
  *
  * study_volume --defaults [--models DIR] [--repeat N] [--reference-rays N] [--only TEXT]
- * (models whose name contains TEXT): the default
+ * [--all-references] (models whose name contains TEXT; fine-grid references for the other
+ * Table 1 models too, slow): the default
  * quadrature (cells of the object's frame, quadrature_subrays.c) on primitives and shared
  * models, for each ray setting: depth 0 without correction (the midpoint rule of 4 x 4 rays
  * per finest cell, the quadrature before issue 27), then depths 0-3 with the curvature
@@ -176,11 +177,13 @@ static int grid_reference(const sem_model *m, int n, double *mean, double *sprea
     return ok;
 }
 
-static int study_defaults(const char *dir, int repeat, int reference_rays, const char *only)
+static int study_defaults(const char *dir, int repeat, int reference_rays, const char *only,
+                          int all_references)
 {
     printf("# model depth correct points rays volume reference relative_error quad_s\n");
     /* the first 12 have references (exact, divergence theorem, fine grids); the rest are the
-     * other Table 1 models, for points, rays and time (no reference: nan) */
+     * other Table 1 models, for points, rays and time (nan: no reference, unless
+     * --all-references asks for their fine grids too) */
     const char *names[] = {"sphere", "torus", "cylinder", "box", "rounded_cube.iges",
                            "beams/perf/b1.igs", "beams/perf/b4.igs", "beams/perf/b10.igs",
                            "beams/beam_cmp3_b.iges", "mugs/mug_trimmed_complex.iges",
@@ -229,7 +232,7 @@ static int study_defaults(const char *dir, int repeat, int reference_rays, const
                 sem_raycast_scene_destroy(scene);
             } else if (built && k < 9) {
                 reference = 5.0; /* the box beams: 5 x 1 x 1 */
-            } else if (built && k >= 12) {
+            } else if (built && k >= 12 && !all_references) {
                 reference = NAN;
             } else if (built) {
                 double spread = 0;
@@ -271,17 +274,19 @@ int main(int argc, char **argv)
     const char *dir_arg = NULL, *list = "2,3,4,6,8,12,16,24,32,48,64,96";
     int defaults = 0, repeat = 3, reference_rays = 400;
     const char *only = NULL;
+    int all_references = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--models") && i + 1 < argc) dir_arg = argv[++i];
         else if (!strcmp(argv[i], "--rays") && i + 1 < argc) list = argv[++i];
         else if (!strcmp(argv[i], "--defaults")) defaults = 1;
         else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+        else if (!strcmp(argv[i], "--all-references")) all_references = 1;
         else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--reference-rays") && i + 1 < argc) reference_rays = atoi(argv[++i]);
         else {
             fprintf(stderr,
                     "usage: %s [--models DIR] [--rays LIST] | --defaults [--models DIR] "
-                    "[--repeat N] [--reference-rays N] [--only TEXT]\n",
+                    "[--repeat N] [--reference-rays N] [--only TEXT] [--all-references]\n",
                     argv[0]);
             return 2;
         }
@@ -291,7 +296,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "study_volume: --repeat and --reference-rays must be in range\n");
             return 2;
         }
-        return study_defaults(models_dir(dir_arg), repeat, reference_rays, only);
+        return study_defaults(models_dir(dir_arg), repeat, reference_rays, only, all_references);
     }
     int rays[64], n_rays = 0;
     for (const char *p = list; *p && n_rays < 64;) {
