@@ -8,6 +8,7 @@
 
 #include "preprocess/raycast.h"
 #include "sem/model.h"
+#include "sem/nurbs.h"
 #include "sem/primitives.h"
 #include "test_util.h"
 
@@ -124,8 +125,17 @@ static void test_cube(int degree, int resolution)
             CHECK(hits[0].part == 0 && hits[1].part == 1, "parts %d %d", hits[0].part,
                   hits[1].part);
             CHECK(hits[0].normal[0] < 0 && hits[1].normal[0] > 0, "enter then leave");
+            /* on the exact surface, inside one part: smooth, (u,v) the point hit */
+            for (int q = 0; q < 2; ++q) {
+                double X[3];
+                sem_surface_eval(&m->parts[hits[q].part].surface, hits[q].u, hits[q].v, X, NULL,
+                                 NULL, NULL);
+                CHECK(hits[q].smooth, "ray (%g, %g): hit %d not smooth", yz[k][0], yz[k][1], q);
+                for (int d = 0; d < 3; ++d) CHECK_NEAR(X[d], o[d] + hits[q].t * dx[d], 1e-12);
+            }
         }
     }
+
     /* a vertical ray: along z through y = 0.5, x = 0.5 */
     {
         const double o[3] = {0.5, 0.5, -2.0}, dz[3] = {0, 0, 1};
@@ -191,6 +201,36 @@ static void test_cube(int degree, int resolution)
 
 /* Two separate cubes, the second entirely flipped (all its normals inward): the fix is per
  * part and finds them all. */
+/* Two unit boxes touching at x = 1: the crossing there is merged from two parts' hits (one
+ * leaving, one entering), where the surface has no one tangent plane: not smooth; the outer
+ * faces' hits are. */
+static void test_touching_boxes(void)
+{
+    sem_model *m = sem_model_create();
+    sem_error err;
+    for (int k = 0; k < 2; ++k) {
+        sem_box_def b = sem_default_box_def();
+        b.center[0] = 0.5 + k;
+        b.center[1] = b.center[2] = 0.5;
+        CHECK(sem_primitive_box(m, &b, &err) == SEM_OK, "box: %s", err.message);
+    }
+    sem_raycast_scene *scene = NULL;
+    if (sem_raycast_scene_build(m, 4, &scene, &err) == SEM_OK) {
+        const double o[3] = {-1.0, 0.3, 0.7}, dx[3] = {1, 0, 0};
+        sem_ray_hit hits[8];
+        int n = sem_raycast_all(scene, o, dx, 0.0, INFINITY, hits, 8);
+        CHECK(n == 4, "%d hits", n);
+        for (int q = 0; q < n && q < 8; ++q) {
+            int at_seam = fabs(hits[q].t - 2.0) < 1e-9;
+            CHECK(hits[q].smooth == !at_seam, "hit at t = %g: smooth %d", hits[q].t, hits[q].smooth);
+        }
+    } else {
+        CHECK(0, "scene: %s", err.message);
+    }
+    sem_raycast_scene_destroy(scene);
+    sem_model_destroy(m);
+}
+
 static void test_inverted_solid(void)
 {
     sem_model *m = sem_model_create();
@@ -274,6 +314,7 @@ static void test_errors(void)
 
 int main(void)
 {
+    test_touching_boxes();
     test_cube(1, 4);
     test_cube(3, 5);
     test_inverted_solid();

@@ -46,6 +46,13 @@
 _Static_assert(sizeof(int) == 4, "sem assumes 32-bit int");
 
 #define SEM_DISC_FORMAT_VERSION 6u
+/* The revision of what the default quadrature computes (object-frame cells, no `rays`): the
+ * file's layout is that of SEM_DISC_FORMAT_VERSION, but a cached discretization made by an
+ * earlier revision holds other points for the same model and options, so the revision salts
+ * their hash (sem_preprocess_hash) and such entries are made again. 1: rays refined and the
+ * midpoint rule corrected by the surface's curvature (issue 27). The authors' explicit ray
+ * grids compute what they did, and keep their hashes. */
+#define SEM_DEFAULT_QUADRATURE_REVISION 1
 #define SEM_DISC_BYTE_ORDER 0x01020304u
 static const char sem_disc_magic[8] = {'S', 'E', 'M', 'D', 'I', 'S', 'C', '\0'};
 
@@ -252,6 +259,8 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
                              o->youngs_modulus, o->spacing};
         fnv_doubles(&f, v, 6);
         fnv_int(&f, o->tessellation);
+        if (o->rays[0] == 0 && o->rays[1] == 0 && o->points_per_interval == 0)
+            fnv_int(&f, SEM_DEFAULT_QUADRATURE_REVISION);
         fnv_int(&f, o->origin_rule);
         fnv_int(&f, sem_preprocess_shared_fit(model, o));
         fnv_int(&f, sem_preprocess_q_space(model, o));

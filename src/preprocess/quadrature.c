@@ -92,10 +92,15 @@ int sem_ray_points_push(sem_ray_points *r, int *cap, const double X[3], double v
  * on out of memory. */
 int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[3],
                         const double dir[3], double t_begin, double t_end, double length,
-                             sem_ray_segment **seg_out, int *n_seg_out)
+                             sem_ray_segment **seg_out, int *n_seg_out, sem_ray_hit **hits_out,
+                             int *n_hits_out)
 {
     *seg_out = NULL;
     *n_seg_out = 0;
+    if (hits_out) {
+        *hits_out = NULL;
+        *n_hits_out = 0;
+    }
     sem_ray_hit local[64];
     sem_ray_hit *hits = local;
     int n = sem_raycast_all(scene, origin, dir, 0.0, length, hits, 64);
@@ -189,6 +194,17 @@ int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[
             seg[i].inside = sem_raycast_winding_above(scene, X, WINDING_INSIDE);
         }
     }
+    if (hits_out) {
+        sem_ray_hit *copy = malloc((size_t)n * sizeof *copy);
+        if (!copy) {
+            ok = 0;
+            free(seg);
+            goto done;
+        }
+        memcpy(copy, hits, (size_t)n * sizeof *copy);
+        *hits_out = copy;
+        *n_hits_out = n;
+    }
     *seg_out = seg;
     *n_seg_out = n_seg;
 done:
@@ -207,7 +223,9 @@ static int quadrature_ray(const sem_raycast_scene *scene, const double origin[3]
 {
     sem_ray_segment *seg;
     int n_seg;
-    if (!sem_ray_inside_segments(scene, origin, dir, t_begin, t_end, length, &seg, &n_seg)) return 0;
+    if (!sem_ray_inside_segments(scene, origin, dir, t_begin, t_end, length, &seg, &n_seg, NULL,
+                                 NULL))
+        return 0;
     int ok = 1, cap = 0, i = 0;
     while (i < n_seg && ok) {
         if (!seg[i].inside) {
@@ -320,6 +338,15 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err)
 {
+    return sem_step_quadrature_with(model, scene, o, NULL, d, NULL, err);
+}
+
+sem_status sem_step_quadrature_with(const sem_model *model, const sem_raycast_scene *scene,
+                                    const sem_preprocess_options *o,
+                                    const sem_subray_settings *settings, sem_discretization *d,
+                                    long long *n_rays_cast, sem_error *err)
+{
+    if (n_rays_cast) *n_rays_cast = 0;
     if (!scene || !o || !d)
         return sem_error_set(err, SEM_ERR_INVALID, "quadrature: NULL scene, options or output");
     int explicit_grid = o->rays[0] != 0 || o->rays[1] != 0;
@@ -364,7 +391,8 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
     sem_ray_points *rays = NULL;
     if (g.cell_size > 0) {
         /* the object-frame grid of cells (quadrature_cells.c): points per column */
-        sem_status cst = sem_quadrature_cells(model, scene, g.cell_size, d, &rays, &n_rays, err);
+        sem_status cst = sem_quadrature_cells(model, scene, g.cell_size, settings, d, &rays,
+                                              &n_rays, n_rays_cast, err);
         if (cst != SEM_OK) {
             for (int r = 0; rays && r < n_rays; r++) {
                 free(rays[r].X);
@@ -375,6 +403,7 @@ sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *
             return cst;
         }
     } else {
+        if (n_rays_cast) *n_rays_cast = n_rays;
         rays = calloc((size_t)n_rays, sizeof *rays);
         if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     /* a ray costs 5-20 us (exact hit refinement, winding-number vetoes), so even the

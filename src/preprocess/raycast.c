@@ -33,8 +33,10 @@
  *   grazing rays, trim edges). So intervals along a ray do not carry the tessellation's
  *   chord error: a sphere's ray-cast volume is the exact midpoint rule across the ray
  *   grid (0.82% at 10 x 10 rays, 0.076% at 40 x 40) for any tessellation that does not
- *   miss the ray near the silhouette. sem_raycast_first keeps the triangle's t (cheap; the
- *   weights only need distances).
+ *   miss the ray near the silhouette. A hit keeps its (u,v) and whether it is smooth: on the
+ *   exact surface and inside one part (a crossing merged from hits of several parts is at a
+ *   seam), so the quadrature can use the surface's curvature there (hit_curvature.c).
+ *   sem_raycast_first keeps the triangle's t (cheap; the weights only need distances).
  * - Orientation fix (part_sign). CAD files have inward faces. For each part we pick up to
  *   9 sample triangles (the largest triangle of each of 9 equal slices of the part's
  *   triangle list, so the samples spread over the part) and from each centre cast 5 pairs
@@ -195,7 +197,8 @@ typedef struct hit_collector {
  * and the exact t when it converges within the triangle's size of the triangle hit
  * (otherwise, e.g. at a collapsed pole or for a grazing ray, the triangle's t stays). */
 static int refine_hit(const sem_raycast_scene *s, int part, int global, const double *o,
-                      const double *d, double t_tri, double *t_out)
+                      const double *d, double t_tri, double *t_out, double *u_out,
+                      double *v_out)
 {
     const double *v = s->tri + 9 * (size_t)global;
     const double *uv = s->tri_uv + 6 * (size_t)global;
@@ -223,6 +226,8 @@ static int refine_hit(const sem_raycast_scene *s, int part, int global, const do
         if (sqrt(dot3(F, F)) <= tol) {
             if (fabs(t - t_tri) > size) return 0;
             *t_out = t;
+            *u_out = u;
+            *v_out = vv;
             return 1;
         }
         double bc[3], rhs[3] = {-F[0], -F[1], -F[2]}, tmp[3];
@@ -262,9 +267,14 @@ static void make_hit(const sem_raycast_scene *s, const double *o, const double *
     double dn = dot3(d, n);
     double t = embree_t;
     if (fabs(dn) > 1e-12) t = dot3(w, n) / dn;
+    int smooth = 0;
+    double u = 0, v = 0;
     if (refine) {
         double te;
-        if (refine_hit(s, part, global, o, d, t, &te)) t = te;
+        if (refine_hit(s, part, global, o, d, t, &te, &u, &v)) {
+            t = te;
+            smooth = 1;
+        }
     }
     double sign = use_sign ? (double)s->part_sign[part] : 1.0;
     h->t = t;
@@ -273,6 +283,9 @@ static void make_hit(const sem_raycast_scene *s, const double *o, const double *
     h->normal[0] = sign * n[0];
     h->normal[1] = sign * n[1];
     h->normal[2] = sign * n[2];
+    h->u = u;
+    h->v = v;
+    h->smooth = smooth;
 }
 
 static void collect_filter(const struct RTCFilterFunctionNArguments *args)
@@ -364,6 +377,9 @@ static int merge_hits(const sem_raycast_scene *s, const double *dir, sem_ray_hit
         }
         memcpy(tmp, hits + i, (size_t)len * sizeof *tmp);
         double t0 = tmp[0].t;
+        /* where two parts meet (a seam, a corner) the surface has no one tangent plane */
+        int several_parts = 0;
+        for (int k = 1; k < len; k++) several_parts |= tmp[k].part != tmp[0].part;
         for (int pass = 0; pass < 2; pass++) {
             int want = pass == 0 ? -1 : 1;
             for (int k = 0; k < len; k++) {
@@ -382,6 +398,7 @@ static int merge_hits(const sem_raycast_scene *s, const double *dir, sem_ray_hit
                     if (tmp[m].part == part && facing(dir, &tmp[m]) == want) {
                         hits[out] = tmp[m];
                         hits[out].t = t0;
+                        if (several_parts) hits[out].smooth = 0;
                         out++;
                         break;
                     }
@@ -1699,6 +1716,12 @@ int sem_raycast_triangles(const sem_raycast_scene *scene, const double **triangl
     if (normals) *normals = scene ? scene->tri_normal : NULL;
     if (part_offset) *part_offset = scene ? scene->part_tri_offset : NULL;
     return scene ? scene->n_triangles : 0;
+}
+
+const sem_surface *sem_raycast_part_surface(const sem_raycast_scene *scene, int part)
+{
+    if (!scene || !scene->surfaces || part < 0 || part >= scene->n_parts) return NULL;
+    return &scene->surfaces[part];
 }
 
 int sem_raycast_part_sign(const sem_raycast_scene *scene, int part)

@@ -23,6 +23,10 @@ typedef struct sem_ray_hit {
     int part;         /* geomID */
     int triangle;     /* primID */
     double normal[3]; /* unit geometric normal, orientation-corrected (points outward) */
+    double u, v;      /* the part's parameters at the hit (sem_raycast_all: on the exact surface) */
+    int smooth;       /* sem_raycast_all: 1 when the hit is on the exact surface (Newton
+                         converged) and inside one part (not where two parts meet), so the
+                         surface's derivatives there describe the crossing */
 } sem_ray_hit;
 
 /* Builds the scene from a tessellation with `resolution` cells per knot span. */
@@ -37,7 +41,8 @@ int sem_raycast_first(const sem_raycast_scene *scene, const double origin[3], co
 /* All hits along the ray in (t_near, t_far), sorted by t; writes at most max_hits, returns
  * the total count. Hits are refined onto the exact NURBS surface (Newton from the
  * triangle's (u,v)); hits of one part at (nearly) one t - shared edges and vertices of the
- * tessellation - are merged into one crossing, touching ones removed. Thread-safe. */
+ * tessellation - are merged into one crossing, touching ones removed; a crossing where
+ * several parts meet is not smooth. Thread-safe. */
 int sem_raycast_all(const sem_raycast_scene *scene, const double origin[3], const double dir[3],
                     double t_near, double t_far, sem_ray_hit *hits, int max_hits);
 /* Closest point on each part within radius of X: calls back per part with the smallest
@@ -74,6 +79,8 @@ int sem_raycast_part_component(const sem_raycast_scene *scene, int part);
  * part i are [part_offset[i], part_offset[i + 1]). Returns the triangle count. */
 int sem_raycast_triangles(const sem_raycast_scene *scene, const double **triangles,
                           const double **areas, const double **normals, const int **part_offset);
+/* The scene's copy of a part's surface (read-only), for derivatives at a hit's (u, v). */
+const sem_surface *sem_raycast_part_surface(const sem_raycast_scene *scene, int part);
 /* Orientation correction of a part, +1 or -1. */
 int sem_raycast_part_sign(const sem_raycast_scene *scene, int part);
 

@@ -56,17 +56,39 @@ typedef struct sem_ray_segment {
 
 /* quadrature.c: the inside segments of one ray through the box [t_begin, t_end] (CSG union by
  * enter/leave counting, winding-number fallback and veto; see quadrature.c). *seg is
- * allocated (n_hits + 1 segments, *n_seg 0 when nothing is hit). Returns 0 when out of
- * memory. */
+ * allocated (n_hits + 1 segments, *n_seg 0 when nothing is hit): segment i runs from hit i - 1
+ * to hit i (segment 0 from t_begin, the last to t_end). When hits is not NULL, *hits gets the
+ * hits (allocated, caller frees; NULL when there are none) and *n_hits their count. Returns 0
+ * when out of memory. */
 int sem_ray_inside_segments(const sem_raycast_scene *scene, const double origin[3],
                             const double dir[3], double t_begin, double t_end, double length,
-                            sem_ray_segment **seg, int *n_seg);
+                            sem_ray_segment **seg, int *n_seg, sem_ray_hit **hits,
+                            int *n_hits);
+
+/* hit_curvature.c: the surface near the point S(u, v) as a height field t = g(y, z) along the
+ * unit direction d over the plane of the unit axes e1, e2 (d, e1, e2 orthonormal): H = {g_yy,
+ * g_zz, g_yz} and *facing = |n . d|. Returns 0 where that is undefined (the direction in the
+ * tangent plane, a singular parametrization). */
+int sem_hit_height_hessian(const sem_surface *surface, double u, double v, const double d[3],
+                           const double e1[3], const double e2[3], double H[3], double *facing);
+
+/* How quadrature_subrays.c integrates the inside volume of the default quadrature's columns:
+ * levels of refinement below 4 x 4 rays per finest cell, the roughness above which a crossing
+ * is refined and not corrected, and whether the midpoint rule is corrected by the surface's
+ * curvature. The defaults are what sem_preprocess uses; bench/study_volume varies them. */
+typedef struct sem_subray_settings {
+    int max_depth;
+    double rough;
+    int correct;
+} sem_subray_settings;
+sem_subray_settings sem_subray_default_settings(void);
 
 /* quadrature_cells.c: the default quadrature, cells of size h in the object's frame refined near
  * small parts and thin solids (model may be NULL: no thickness), one point per cell: *columns gets one sem_ray_points per column (caller frees),
  * sets quad_spacing. */
 sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene *scene, double h,
-                                sem_discretization *d, sem_ray_points **columns, int *n_columns,
+                                const sem_subray_settings *settings, sem_discretization *d,
+                                sem_ray_points **columns, int *n_columns, long long *n_rays,
                                 sem_error *err);
 
 /* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
@@ -74,6 +96,12 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
 sem_status sem_step_quadrature(const sem_model *model, const sem_raycast_scene *scene,
                                const sem_preprocess_options *o, sem_discretization *d,
                                sem_error *err);
+/* The same with the default quadrature's ray settings (NULL: the defaults); *n_rays (may be
+ * NULL) gets the number of rays cast. For studies of the quadrature. */
+sem_status sem_step_quadrature_with(const sem_model *model, const sem_raycast_scene *scene,
+                                    const sem_preprocess_options *o,
+                                    const sem_subray_settings *settings, sem_discretization *d,
+                                    long long *n_rays, sem_error *err);
 
 /* point_materials.c: rewrites quad_part, the quadrature's innermost entered part, to the
  * part of that part's component with the largest weight at the point (needs W). */
