@@ -190,6 +190,7 @@ static void worst_cases(void)
         /* its one loop does not close (trim_fix.c leaves it out with a warning) before its
          * spans are counted: the face is untrimmed and flat */
         {0, "iges/trim_many_spans.igs", NULL, "encloses no volume"},
+        {0, "iges/trim_many_spans_closed.igs", "SEM_MAX_TRIM_SEGMENTS", "SEM_MAX_TRIM_SEGMENTS"},
         {0, "iges/self_reference.igs", NULL, "encloses no volume"},
         {0, "iges/control_bytes.igs", "is not a number", "is not a number"},
         {1, "obj/trim_references.obj", "SEM_MAX_MODEL_CONTROL_POINTS", "SEM_MAX_MODEL_CONTROL_POINTS"},

@@ -171,6 +171,11 @@ def trim_many_spans(spans=9000):
     curve = Ent(126, nurbs_curve(1, knots, pts, fmt=lambda x: "%.4g" % x), status=SUB)
     E = trimmed_patch_with_loop([curve], 3)
     save("iges", "trim_many_spans.igs", build(E))
+    # the same zig-zag closed back to its start: a loop that closes, so its spans are counted
+    pts.append(pts[0])
+    knots = [0, 0] + list(range(1, spans + 1)) + [spans + 1, spans + 1]
+    curve = Ent(126, nurbs_curve(1, knots, pts, fmt=lambda x: "%.4g" % x), status=SUB)
+    save("iges", "trim_many_spans_closed.igs", build(trimmed_patch_with_loop([curve], 3)))
 
 
 def self_references():
