@@ -61,8 +61,9 @@ static double anchored_motion(const sem_discretization *d, const double box[6], 
 
 /* A static solve of the model under gravity (0, 0, -10), E 1e6, held by `pinned` control
  * points and / or `regions`; returns q (caller frees) or NULL. */
-static double *solve_static(const sem_model *m, const sem_discretization *d, const unsigned char *pinned,
-                            const sem_pin_region *regions, int n_regions, sem_solver_choice solver, const char *what)
+static double *solve_static_checked(const sem_model *m, const sem_discretization *d, const unsigned char *pinned,
+                                    const sem_pin_region *regions, int n_regions, sem_solver_choice solver,
+                                    const char *what, sem_object_checks *checks)
 {
     sem_error err;
     sem_world_def wd = sem_default_world_def();
@@ -85,9 +86,16 @@ static double *solve_static(const sem_model *m, const sem_discretization *d, con
         size_t n = 3 * (size_t)d->n_ctrl;
         q = malloc(n * sizeof *q);
         if (q) memcpy(q, sem_world_object_q(w, 0), n * sizeof *q);
+        if (checks && sem_world_object_checks(w, 0, checks, &err) != SEM_OK) CHECK(0, "%s: checks: %s", what, err.message);
     }
     sem_world_destroy(w);
     return q;
+}
+
+static double *solve_static(const sem_model *m, const sem_discretization *d, const unsigned char *pinned,
+                            const sem_pin_region *regions, int n_regions, sem_solver_choice solver, const char *what)
+{
+    return solve_static_checked(m, d, pinned, regions, n_regions, solver, what, NULL);
 }
 
 /* Mean -u_z of the control points of the parts that lie wholly at x = L (the free end cap,
@@ -336,8 +344,17 @@ static void test_volume_hold(void)
     const sem_pin_region slab = {{-1, -1, -1, 0.001, 2, 2}, -1}, tenth = {{-1, -1, -1, 0.5, 2, 2}, -1};
     unsigned char *clamp = control_box(m, slab.box);
     double *qc = solve_static(m, d, clamp, NULL, 0, SEM_SOLVER_AUTO, "one-section beam, clamp");
-    double *qs = solve_static(m, d, NULL, &slab, 1, SEM_SOLVER_AUTO, "one-section beam, thin slab");
-    double *qt = solve_static(m, d, NULL, &tenth, 1, SEM_SOLVER_AUTO, "one-section beam, first 10 %");
+    sem_object_checks cs, ct;
+    cs.pin_part = ct.pin_part = -2;
+    double *qs = solve_static_checked(m, d, NULL, &slab, 1, SEM_SOLVER_AUTO, "one-section beam, thin slab", &cs);
+    double *qt = solve_static_checked(m, d, NULL, &tenth, 1, SEM_SOLVER_AUTO, "one-section beam, first 10 %", &ct);
+    /* the trust check (pins.h, sem_pins_held_parts): the thin slab holds no side face whole;
+     * the first 10 % holds the side faces' polynomials, whose faces run the whole length */
+    printf("one-section beam: held part (suspect) thin slab %d, first 10 %% %d (%.0f %% of it outside)\n", cs.pin_part,
+           ct.pin_part, 100 * ct.pin_outside);
+    CHECK(cs.pin_part == -1 && !(cs.suspect & SEM_SUSPECT_PIN), "thin slab flagged: part %d", cs.pin_part);
+    CHECK(ct.pin_part >= 0 && (ct.suspect & SEM_SUSPECT_PIN) && ct.pin_outside > 0.7,
+          "the first 10 %% holds whole faces but is not flagged (part %d, %.3f outside)", ct.pin_part, ct.pin_outside);
     if (qc && qs && qt) {
         double sc = far_sag(d, qc, 5), ss = far_sag(d, qs, 5), st = far_sag(d, qt, 5);
         printf("one-section beam, sag of the far 10 %%: control-point clamp %.4f m, material of x <= 0.001 %.4f m, "

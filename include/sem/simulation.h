@@ -255,6 +255,10 @@ typedef struct sem_object_checks {
     double volume_change;     /* sum_p vol_p det F_p / rest volume - 1 (reported only: loads
                                  and prescribed motion change a body's volume legitimately) */
     double min_det_f;         /* smallest det F over the quadrature points */
+    int pin_part;             /* a part whose whole polynomial a material pin box holds while
+                                 pin_outside of its material lies outside every box (the
+                                 largest such share); -1 when none (src/physics/pins.h) */
+    double pin_outside;
     int suspect;              /* SEM_SUSPECT_* flags of the limits below that are passed */
 } sem_object_checks;
 
@@ -267,6 +271,8 @@ typedef struct sem_object_checks {
 #define SEM_SUSPECT_ERROR_SHARE 2
 #define SEM_SUSPECT_INVERTED 4       /* min_det_f <= 0: an element turned inside out (a
                                         material that allows it: linear, St. Venant-Kirchhoff) */
+#define SEM_SUSPECT_PIN 8            /* pin_part >= 0: a pin box holds material beyond itself */
+#define SEM_SUSPECT_COUNT 4          /* flags above: bits 0 .. SEM_SUSPECT_COUNT - 1 */
 
 /* The checks of object `object` now. The first call finds the object's seams (a pass over
  * its parts' boundaries, about the cost of a few steps); later calls cost about one

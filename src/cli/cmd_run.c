@@ -106,7 +106,7 @@ typedef struct run_state {
      * kind, and for each limit passed the first frame and object that passed it */
     double worst_seam, worst_share, worst_volume;
     int suspect;                      /* SEM_SUSPECT_* flags passed so far */
-    char suspect_message[3][512];     /* per flag bit: the warning of its first frame */
+    char suspect_message[SEM_SUSPECT_COUNT][512];     /* per flag bit: the warning of its first frame */
     int strict;                       /* --strict: the first suspect frame fails the run */
 } run_state;
 
@@ -184,7 +184,7 @@ static void add_object_checks(run_state *r, int i, int frame, cJSON *o)
     if (c.error_share > r->worst_share) r->worst_share = c.error_share;
     if (fabs(c.volume_change) > fabs(r->worst_volume) || !isfinite(c.volume_change)) r->worst_volume = c.volume_change;
     const sem_model *m = sem_scene_world_model(r->sw, i);
-    for (int bit = 0; bit < 3; ++bit) {
+    for (int bit = 0; bit < SEM_SUSPECT_COUNT; ++bit) {
         int flag = 1 << bit;
         if (!(c.suspect & flag) || (r->suspect & flag)) continue;
         r->suspect |= flag;
@@ -205,6 +205,15 @@ static void add_object_checks(run_state *r, int i, int frame, cJSON *o)
                      "stored (limit %g %%): the polynomials no longer follow the surface; the "
                      "answer is suspect (sem.resolution gives each face more polynomials)",
                      i, frame, 100 * c.error_share, 100 * SEM_ERROR_SHARE_LIMIT);
+        } else if (flag == SEM_SUSPECT_PIN) {
+            char a[96];
+            part_label(m, c.pin_part, a, sizeof a);
+            snprintf(msg, size,
+                     "object %d: its pin box holds all of %s's polynomial, and %.0f %% of that "
+                     "part's material lies outside the box and cannot deform (one polynomial per "
+                     "part, Eq. 7): the answer is stiffer than the body; the answer is suspect (pin "
+                     "a thin slab at a face, or cut the parts into patches with sem.resolution)",
+                     i, a, 100 * c.pin_outside);
         } else {
             snprintf(msg, size,
                      "object %d, frame %d: an element turned inside out (smallest det F %.3g): the "
@@ -308,7 +317,7 @@ static cJSON *summary(run_state *r, const char *status, const char *error, const
     else
         cJSON_AddNullToObject(checks, "volume_change_max");
     cJSON *why = cJSON_AddArrayToObject(checks, "suspect");
-    for (int bit = 0; bit < 3; ++bit)
+    for (int bit = 0; bit < SEM_SUSPECT_COUNT; ++bit)
         if (r->suspect & (1 << bit)) cJSON_AddItemToArray(why, cJSON_CreateString(r->suspect_message[bit]));
     /* every number below is SI (metres, kg, s); frame files are in frame_units */
     cJSON_AddStringToObject(s, "units", "SI (m, kg, s)");
@@ -756,7 +765,7 @@ int cmd_run(int argc, char **argv)
         }
         add_frame_stats(&r, stats);
         if (r.strict && r.suspect) {
-            for (int bit = 0; bit < 3; ++bit)
+            for (int bit = 0; bit < SEM_SUSPECT_COUNT; ++bit)
                 if (r.suspect & (1 << bit)) {
                     snprintf(failure, sizeof failure, "--strict: %s", r.suspect_message[bit]);
                     break;

@@ -13,6 +13,8 @@
  *   - the volume: sum_p vol_p det F_p against the rest volume, reported (loads and prescribed
  *     motion change it legitimately: the patch test stretches a cube by 10 %), and the
  *     smallest det F: an element turned inside out (materials that allow it) is suspect.
+ * And one of the setup: a material pin box that holds all of a part's polynomial while the
+ * part reaches beyond it (pins.h, sem_pins_held_parts) makes that material rigid.
  * Each has a limit (sem/simulation.h); a state beyond one is suspect.
  */
 #include <math.h>
@@ -20,12 +22,14 @@
 #include <string.h>
 
 #include "assembly.h"
+#include "pins.h"
 #include "world.h"
 
 sem_status sem_world_object_checks(sem_world *w, int object, sem_object_checks *out, sem_error *err)
 {
     memset(out, 0, sizeof *out);
     out->seam_parts[0] = out->seam_parts[1] = -1;
+    out->pin_part = -1;
     if (object < 0 || object >= w->n_objects)
         return sem_error_set(err, SEM_ERR_INVALID, "no object %d (the world has %d)", object, w->n_objects);
     sem_object *o = w->objects[object];
@@ -61,5 +65,10 @@ sem_status sem_world_object_checks(sem_world *w, int object, sem_object_checks *
     if (out->seam_gap_relative > SEM_SEAM_GAP_LIMIT) out->suspect |= SEM_SUSPECT_SEAM;
     if (out->error_share > SEM_ERROR_SHARE_LIMIT) out->suspect |= SEM_SUSPECT_ERROR_SHARE;
     if (!(min_det > 0)) out->suspect |= SEM_SUSPECT_INVERTED;
+    if (o->pins && o->pins->held_part >= 0) {
+        out->pin_part = o->pins->held_part;
+        out->pin_outside = o->pins->held_outside;
+        out->suspect |= SEM_SUSPECT_PIN;
+    }
     return SEM_OK;
 }

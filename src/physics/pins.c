@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <lapacke.h>
+
 #include "loads.h"
 
 static int in_box(const double box[6], const double X[3])
@@ -154,6 +156,7 @@ sem_status sem_pins_init(sem_object *o, const sem_object_def *def, sem_error *er
         }
     }
     for (int a = 0; a < p->n_points; ++a) p->moves |= p->presc[a] >= 0;
+    sem_pins_held_parts(o, def);
     /* the parts the anchors touch, for the products */
     p->touched_slot = malloc(((size_t)o->n_parts + 1) * sizeof(int));
     p->touched = malloc(((size_t)o->n_parts + 1) * sizeof(int));
@@ -166,6 +169,112 @@ sem_status sem_pins_init(sem_object *o, const sem_object_def *def, sem_error *er
             p->touched[p->n_touched++] = i;
         }
     return SEM_OK;
+}
+
+/* Adds point X (weight w, the part's blending weight wi) to part i's form H += w e e^T,
+ * e = wi b(X - Xbar_i). */
+static void add_form(const sem_object *o, int i, double wi, const double X[3], double w, double *H)
+{
+    const sem_discretization *d = o->d;
+    const int m = o->m;
+    const double *Xb = d->origin_X + 3 * (size_t)d->part_origin[i];
+    double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, e[10];
+    sem_polynomial_basis(d->order, dX, e, NULL);
+    for (int r = 0; r < m; ++r)
+        for (int c = 0; c < m; ++c) H[r * m + c] += w * wi * wi * e[r] * e[c];
+}
+
+void sem_pins_held_parts(const sem_object *o, const sem_object_def *def)
+{
+    sem_pins *p = o->pins;
+    const sem_discretization *d = o->d;
+    const int m = o->m, np = o->n_parts, mm = m * m;
+    p->held_part = -1;
+    p->held_outside = 0;
+    if (m > 10) return;
+    /* per part: its material's form (every quadrature point and sample it blends into), the
+     * held part of it, and the material's weight inside and outside the boxes */
+    double *all = calloc((size_t)np * mm + 1, sizeof(double)), *held = calloc((size_t)np * mm + 1, sizeof(double));
+    double *total = calloc((size_t)np + 1, sizeof(double)), *outside = calloc((size_t)np + 1, sizeof(double));
+    double *lo = malloc((size_t)np * 3 * sizeof(double) + 1), *hi = malloc((size_t)np * 3 * sizeof(double) + 1);
+    if (!all || !held || !total || !outside || !lo || !hi) goto done; /* a check only */
+    for (int i = 0; i < 3 * np; ++i) lo[i] = INFINITY, hi[i] = -INFINITY;
+    double h = d->quad_spacing > 0 ? d->quad_spacing : (d->n_quad > 0 ? cbrt(d->volume / d->n_quad) : d->length_scale);
+    /* held: the anchored points (quadrature points and samples, through their blending
+     * weights); all: the part's own surface (its samples, its own polynomial), which is what
+     * the user sees move */
+    for (int t = 0; t < 2; ++t) {
+        const sem_csr *W = t ? &d->W_samples : &d->W;
+        int n = t ? d->n_samples : d->n_quad;
+        const double *XX = t ? d->sample_X : d->quad_X;
+        for (int q = 0; q < n; ++q) {
+            const double *X = XX + 3 * (size_t)q;
+            double w = t ? 0.5 * h * d->sample_area[q] : d->quad_volume[q];
+            if (!(w > 0)) continue;
+            int in = 0;
+            for (int r = 0; r < def->n_pin_regions && !in; ++r) in = in_box(def->pin_regions[r].box, X);
+            if (t) {
+                int i = d->sample_part[q];
+                add_form(o, i, 1, X, w, all + (size_t)i * mm);
+                total[i] += w;
+                if (!in) outside[i] += w;
+                for (int k = 0; k < 3; ++k) {
+                    lo[3 * i + k] = fmin(lo[3 * i + k], X[k]);
+                    hi[3 * i + k] = fmax(hi[3 * i + k], X[k]);
+                }
+            }
+            if (!in) continue;
+            for (int e = W->row_start[q]; e < W->row_start[q + 1]; ++e)
+                if (W->val[e] > 0) add_form(o, W->col[e], W->val[e], X, w, held + (size_t)W->col[e] * mm);
+        }
+    }
+    /* Part i is held whole when every motion of its polynomial costs the anchor more than the
+     * part's own stiffness for a motion of its size: k lambda_min > E / L_i^2, lambda_min the
+     * smallest generalized eigenvalue of (held, all) (the held share of the least-held motion
+     * of its surface), L_i the diagonal of its surface. */
+    const double E = largest_modulus(o);
+    for (int i = 0; i < np; ++i) {
+        if (!(total[i] > 0)) continue;
+        double share = outside[i] / total[i];
+        if (share <= SEM_PIN_HELD_OUTSIDE || share <= p->held_outside) continue;
+        const double *A = held + (size_t)i * mm, *B = all + (size_t)i * mm;
+        if (!(A[0] > 0)) continue; /* nothing of this part held */
+        /* lambda_min over the motions the surface shows: B's range (a planar face's samples
+         * do not see the polynomial's terms across its plane), by B = V mu V^T, then the
+         * eigenvalues of mu^-1/2 V^T A V mu^-1/2 */
+        double mu[10], V[100], C[100], AV[100], lambda[10];
+        memcpy(V, B, (size_t)mm * sizeof(double));
+        if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', m, V, m, mu) != 0) continue;
+        int r0 = 0; /* eigenvalues ascend: the range starts at the first above round-off */
+        while (r0 < m && !(mu[r0] > 1e-10 * mu[m - 1])) r0++;
+        int nr = m - r0;
+        if (nr <= 0) continue;
+        for (int r = 0; r < m; ++r) /* AV = A V (the range's columns) */
+            for (int c = 0; c < nr; ++c) {
+                double v = 0;
+                for (int k = 0; k < m; ++k) v += A[r * m + k] * V[k * m + r0 + c];
+                AV[r * nr + c] = v;
+            }
+        for (int r = 0; r < nr; ++r)
+            for (int c = 0; c < nr; ++c) {
+                double v = 0;
+                for (int k = 0; k < m; ++k) v += V[k * m + r0 + r] * AV[k * nr + c];
+                C[r * nr + c] = v / sqrt(mu[r0 + r] * mu[r0 + c]);
+            }
+        if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', nr, C, nr, lambda) != 0) continue;
+        double L2 = 0;
+        for (int k = 0; k < 3; ++k) L2 += (hi[3 * i + k] - lo[3 * i + k]) * (hi[3 * i + k] - lo[3 * i + k]);
+        if (!(p->stiffness * lambda[0] * L2 > E)) continue;
+        p->held_part = i;
+        p->held_outside = share;
+    }
+done:
+    free(all);
+    free(held);
+    free(total);
+    free(outside);
+    free(lo);
+    free(hi);
 }
 
 void sem_pins_add_pair_blocks(const sem_object *o, double *pairs)
