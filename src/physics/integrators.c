@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "assembly.h"
-#include "contact/contact_world.h"
+#include "contact_world.h"
 #include "loads.h"
 #include "pins.h"
 #include "runaway.h"

@@ -22,7 +22,7 @@
 #include <string.h>
 
 #include "assembly.h"
-#include "contact/contact_world.h"
+#include "contact_world.h"
 #include "input_scales.h"
 #include "runaway.h"
 #include "loads.h"

@@ -9,10 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "collision_mesh.h"
-#include "collision_topology.h"
-#include "friction.h"
-#include "penalty.h"
+#include "contact/collision_mesh.h"
+#include "contact/collision_topology.h"
+#include "contact/friction.h"
+#include "contact/penalty.h"
 #include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */

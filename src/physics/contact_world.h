@@ -30,9 +30,9 @@
 #ifndef SEM_CONTACT_WORLD_H
 #define SEM_CONTACT_WORLD_H
 
-#include "physics/object.h"
-#include "physics/point_terms.h"
-#include "physics/system.h"
+#include "object.h"
+#include "point_terms.h"
+#include "system.h"
 #include "sem/contact.h"
 
 typedef struct sem_contact sem_contact;
