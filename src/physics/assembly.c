@@ -14,32 +14,6 @@
 /* Points per assembly chunk when the world's settings give none. */
 #define DEFAULT_ASSEMBLY_CHUNK 8192
 
-/* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
- * (W rows list parts in increasing order). */
-static int pair_has_points(const sem_object *o, int pr)
-{
-    return o->plist_start[pr + 1] > o->plist_start[pr];
-}
-
-/* T with b(y + s) = T b(y) for the polynomial basis (m x m, row-major): the change from a
- * part's own basis, b(X - Xbar_i) with s = ref_X - Xbar_i, to the shared one, b(X - ref_X). */
-void sem_basis_shift(int m, const double s[3], double *T)
-{
-    memset(T, 0, (size_t)m * m * sizeof(double));
-    for (int k = 0; k < m; ++k) T[k * m + k] = 1.0;
-    for (int e = 0; e < 3; ++e) T[(1 + e) * m] = s[e];
-    if (m < 10) return;
-    /* b4..b9 = xy, xz, yz, x^2, y^2, z^2 */
-    static const int pa[6] = {0, 0, 1, 0, 1, 2}, pb[6] = {1, 2, 2, 0, 1, 2};
-    for (int q = 0; q < 6; ++q) {
-        double *row = T + (size_t)(4 + q) * m;
-        int a = pa[q], b = pb[q];
-        row[0] = s[a] * s[b];
-        row[1 + a] += s[b];
-        row[1 + b] += s[a];
-    }
-}
-
 /* The stiffness in one shared basis. With Eq. 15, a part's contribution to F at point p
  * is w_i (grad b(X_p - Xbar_i))^T z_i = w_i (grad b(X_p - ref))^T (T_i^T z_i): every part
  * at p shares the point's D_p = grad b(X_p - ref), so a part pair's block is
@@ -130,17 +104,6 @@ sem_status sem_assembly_init(sem_object *o, int assembly_chunk, sem_error *err)
     return setup_stiffness(o, assembly_chunk > 0 ? assembly_chunk : DEFAULT_ASSEMBLY_CHUNK, err);
 }
 
-const double *sem_centered(sem_object *o, const double *q)
-{
-    double mean[3] = {0, 0, 0};
-    for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) mean[k] += q[3 * c + k];
-    for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
-    for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) o->qc[3 * c + k] = q[3 * c + k] - mean[k];
-    return o->qc;
-}
-
 /* The kernels below are element-wise (no reordered sums, and ISO C mode keeps the compiler
  * from contracting to FMA), so every clone gives the same bits. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
@@ -195,7 +158,7 @@ static void pair_sums(sem_object *o, int c0, int c1)
     int first = c0 == 0, last = c1 == o->n_quad;
 #pragma omp for schedule(dynamic, 8)
     for (int pr = 0; pr < o->n_pairs; ++pr) {
-        if (!pair_has_points(o, pr)) continue;
+        if (!sem_pair_has_points(o, pr)) continue;
         double acc[378];
         if (first) {
             memset(acc, 0, (size_t)np * sizeof(double));
@@ -317,120 +280,6 @@ void sem_point_hessian_multiply(const sem_object *o, double c, int minus_rest, c
     for (int sh = 1; sh < GRADIENT_SHARES; ++sh)
         for (size_t k = 0; k < nz; ++k) share[k] += share[(size_t)sh * nz + k];
     sem_shared_add_transpose(o, share, y);
-}
-
-void sem_shared_coefficients(const sem_object *o, const double *x, double *z)
-{
-    int ma = o->ma;
-#pragma omp parallel for schedule(static) num_threads(o->nthreads)
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = o->d->part_origin[i];
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        double *zi = z + (size_t)i * ma * 3;
-        for (int k = 0; k < ma; ++k) {
-            const double *row = o->pi_shared[i] + (size_t)k * n;
-            double s0 = 0, s1 = 0, s2 = 0;
-            for (size_t j = 0; j < n; ++j) {
-                const double *xc = x + 3 * (size_t)ctrl[j];
-                s0 += row[j] * xc[0];
-                s1 += row[j] * xc[1];
-                s2 += row[j] * xc[2];
-            }
-            zi[k * 3 + 0] = s0;
-            zi[k * 3 + 1] = s1;
-            zi[k * 3 + 2] = s2;
-        }
-    }
-}
-
-void sem_shared_add_transpose(const sem_object *o, const double *z, double *y)
-{
-    int ma = o->ma;
-    /* groups own disjoint control points: one thread per group, its parts in order (the
-     * same bits as the serial loop over parts) */
-#pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
-    for (int g = 0; g < o->n_groups; ++g) {
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        for (int i = 0; i < o->n_parts; ++i) {
-            if (o->d->part_origin[i] != g) continue;
-            const double *zi = z + (size_t)i * ma * 3;
-            for (int k = 0; k < ma; ++k) {
-                const double *row = o->pi_shared[i] + (size_t)k * n;
-                for (size_t j = 0; j < n; ++j) {
-                    double *yc = y + 3 * (size_t)ctrl[j];
-                    yc[0] += row[j] * zi[k * 3 + 0];
-                    yc[1] += row[j] * zi[k * 3 + 1];
-                    yc[2] += row[j] * zi[k * 3 + 2];
-                }
-            }
-        }
-    }
-}
-
-void sem_stiffness_z_multiply(const sem_object *o, double ca, const double *Ka, double cb, const double *Kb,
-                              const double *x, double *y, double *work)
-{
-    int ma = o->ma, n3 = 3 * ma;
-    size_t nz = (size_t)o->n_parts * n3, bs = (size_t)n3 * n3;
-    double *zs = work, *out = work + nz;
-    sem_shared_coefficients(o, x, zs);
-    memset(out, 0, nz * sizeof(double));
-    /* Kz rows (k, d) = 3k + d, columns (d', k') = d' ma + k'; z entries 3k + d. Part a's
-     * output sums its pairs in pair order, as a (K_ab z_b) or as b (K_ba^T z_a'), one thread
-     * per part: the same bits on any thread count. */
-    int *start = calloc((size_t)o->n_parts + 1, sizeof(int));
-    int *list = malloc((2 * (size_t)o->n_pairs + 1) * sizeof(int));
-    if (!start || !list) {
-        free(start);
-        free(list);
-        return; /* unreachable in practice; the product is then incomplete */
-    }
-    for (int pr = 0; pr < o->n_pairs; ++pr)
-        if (o->pair_a[pr] <= o->pair_b[pr] && pair_has_points(o, pr)) {
-            start[o->pair_a[pr] + 1]++;
-            if (o->pair_b[pr] != o->pair_a[pr]) start[o->pair_b[pr] + 1]++;
-        }
-    for (int p = 0; p < o->n_parts; ++p) start[p + 1] += start[p];
-    for (int pr = 0; pr < o->n_pairs; ++pr) {
-        if (o->pair_a[pr] > o->pair_b[pr] || !pair_has_points(o, pr)) continue;
-        list[start[o->pair_a[pr]]++] = pr;
-        if (o->pair_b[pr] != o->pair_a[pr]) list[start[o->pair_b[pr]]++] = pr;
-    }
-    for (int p = o->n_parts; p > 0; --p) start[p] = start[p - 1];
-    start[0] = 0;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(o->nthreads)
-    for (int p = 0; p < o->n_parts; ++p) {
-        double *op = out + (size_t)p * n3;
-        for (int e = start[p]; e < start[p + 1]; ++e) {
-            int pr = list[e], a = o->pair_a[pr], b = o->pair_b[pr];
-            const double *K = Ka + (size_t)pr * bs, *K2 = Kb ? Kb + (size_t)pr * bs : NULL;
-            if (a == p) {
-                const double *zb = zs + (size_t)b * n3;
-                for (int r = 0; r < n3; ++r)
-                    for (int d2 = 0; d2 < 3; ++d2)
-                        for (int k2 = 0; k2 < ma; ++k2) {
-                            size_t at = (size_t)r * n3 + (size_t)(d2 * ma + k2);
-                            double v = ca * K[at] + (K2 ? cb * K2[at] : 0);
-                            op[r] += v * zb[3 * k2 + d2];
-                        }
-            }
-            if (b == p && a != b) {
-                const double *za = zs + (size_t)a * n3;
-                for (int r = 0; r < n3; ++r)
-                    for (int d2 = 0; d2 < 3; ++d2)
-                        for (int k2 = 0; k2 < ma; ++k2) {
-                            size_t at = (size_t)r * n3 + (size_t)(d2 * ma + k2);
-                            double v = ca * K[at] + (K2 ? cb * K2[at] : 0);
-                            op[3 * k2 + d2] += v * za[r];
-                        }
-            }
-        }
-    }
-    free(start);
-    free(list);
-    sem_shared_add_transpose(o, out, y);
 }
 
 /* F at quadrature point p from the current shared-basis coefficients o->z (Eq. 15):
@@ -608,7 +457,7 @@ sem_status sem_assemble_stiffness_blocks(sem_object *o, const sem_fill_target *f
                 for (; k < end && o->pair_a[o->gpair_pairs[k]] == a; ++k) {
                     int pr = o->gpair_pairs[k], b = o->pair_b[pr];
                     int up = a <= b ? pr : o->pair_lookup[(size_t)b * o->n_parts + a];
-                    if (!pair_has_points(o, up)) continue;
+                    if (!sem_pair_has_points(o, up)) continue;
                     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, 3 * n3, nb, ma, 1.0,
                                 o->Kz + (size_t)up * bs, ma, o->pi_shared[b], nb, any ? 1.0 : 0.0, U, nb);
                     any = 1;

@@ -33,6 +33,7 @@
 #define SEM_PHYSICS_ASSEMBLY_H
 
 #include "object.h"
+#include "shared_kernels.h"
 #include "system.h"
 
 /* The per-point loop of the elastic assembly sums into this many gradient and energy
@@ -70,40 +71,10 @@ sem_status sem_assemble_stiffness_blocks(sem_object *o, const sem_fill_target *f
 /* sum_p vol_p det F_p: the volume of the deformed body by the quadrature (Eq. 15's F);
  * *min_det (may be NULL) receives the smallest det F_p. Uses o->z as work. */
 double sem_deformed_volume(sem_object *o, const double *q, double *min_det);
-/* z = pi_shared x (per part ma x 3, coordinates interleaved), x over all control points. */
-void sem_shared_coefficients(const sem_object *o, const double *x, double *z);
-/* y += pi_shared^T z. */
-void sem_shared_add_transpose(const sem_object *o, const double *z, double *y);
-/* y += pi_shared^T (ca Ka + cb Kb) pi_shared x with Ka, Kb laid out as o->Kz (Kb may be
- * NULL). work: 2 n_parts 3 ma doubles. */
-void sem_stiffness_z_multiply(const sem_object *o, double ca, const double *Ka, double cb, const double *Kb,
-                              const double *x, double *y, double *work);
-/* T (m x m, row-major) with b(y + s) = T b(y): from a part's own basis b(X - Xbar_i),
- * s = ref_X - Xbar_i, to the shared one b(X - ref_X) (see setup_stiffness in assembly.c). */
-void sem_basis_shift(int m, const double s[3], double *T);
-/* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
- * energies are translation invariant, but evaluated at q far from the origin their
- * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
- * slowly lose momentum conservation. Evaluating at the centred q removes that. */
-const double *sem_centered(sem_object *o, const double *q);
 
 /* mass_error.c: M_blocks, E_blocks (with the orphan control points' ties), A_blocks (the
  * material pins, pins.h), and the CSR copy of M and E_blocks. */
 sem_status sem_mass_error_init(sem_object *o, sem_error *err);
-/* The boundary samples' weights in the error matrix are their areas, each at least 5 % of
- * its part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area
- * element and its samples would drop out, and with them the only information that fixes the
- * control points of the collapsed row (the system would be singular). */
-/* The rows of the error energy (Eq. 16): per boundary sample one row, the residual of the
- * blended map (entry -1), except on a seam under SEM_SEAMS_GEOMETRIC (a sample whose W_samples
- * row has several parts): one row per part, the residual of that part's polynomial alone
- * (entry: the W_samples entry), weighted by the part's weight times the sample's seam weight
- * (sem_discretization.sample_seam, with the floor of sem_sample_weights). In sample order. */
-typedef struct sem_error_row {
-    int sample, entry;
-    double weight;
-} sem_error_row;
-sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows, sem_error *err);
 /* Error energy gamma q^T M_eps q (Eq. 16) and its gradient 2 gamma M_eps q (into grad). */
 double sem_error_energy(sem_object *o, const double *q, double *grad);
 /* y = (cM M + cE 2 M_eps) x + cK K x + cD K0 x + cA A x over all the object's dofs (A: the

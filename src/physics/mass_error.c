@@ -68,62 +68,6 @@ static void add_projected(const sem_object *o, int pa, int pb, const double *X, 
                 nb, 1.0, block, nb);
 }
 
-/* The error rows' floor (assembly.h): 5 % of each part's mean sample area, per part. */
-static double *part_floors(const sem_discretization *d, int n_parts)
-{
-    double *part_mean = calloc((size_t)n_parts + 1, sizeof(double));
-    int *part_count = calloc((size_t)n_parts + 1, sizeof(int));
-    if (!part_mean || !part_count) {
-        free(part_mean);
-        free(part_count);
-        return NULL;
-    }
-    for (int r = 0; r < d->n_samples; ++r) {
-        part_mean[d->sample_part[r]] += d->sample_area[r];
-        part_count[d->sample_part[r]]++;
-    }
-    for (int i = 0; i < n_parts; ++i) part_mean[i] = part_count[i] ? 0.05 * part_mean[i] / part_count[i] : 0;
-    free(part_count);
-    return part_mean;
-}
-
-sem_status sem_error_rows(const sem_object *o, sem_error_row **rows, int *n_rows, sem_error *err)
-{
-    const sem_discretization *d = o->d;
-    const sem_csr *Ws = &d->W_samples;
-    const int split = o->def.seams != SEM_SEAMS_PAPER;
-    *rows = NULL;
-    *n_rows = 0;
-    size_t n = 0;
-    for (int r = 0; r < d->n_samples; ++r) {
-        int k = Ws->row_start[r + 1] - Ws->row_start[r];
-        n += split && k > 1 ? (size_t)k : 1;
-    }
-    if (n > (size_t)INT_MAX / 2) return sem_error_set(err, SEM_ERR_INVALID, "too many error rows (%zu)", n);
-    double *part_floor = part_floors(d, o->n_parts);
-    sem_error_row *out = malloc((n + 1) * sizeof *out);
-    if (!part_floor || !out) {
-        free(part_floor);
-        free(out);
-        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    }
-    size_t at = 0;
-    for (int r = 0; r < d->n_samples; ++r) {
-        double fl = part_floor[d->sample_part[r]];
-        int e0 = Ws->row_start[r], e1 = Ws->row_start[r + 1];
-        if (!split || e1 - e0 <= 1) {
-            out[at++] = (sem_error_row){r, -1, fmax(d->sample_area[r], fl)};
-            continue;
-        }
-        double seam = fmax(d->sample_seam ? d->sample_seam[r] : d->sample_area[r], fl);
-        for (int e = e0; e < e1; ++e) out[at++] = (sem_error_row){r, e, seam * Ws->val[e]};
-    }
-    free(part_floor);
-    *rows = out;
-    *n_rows = (int)n;
-    return SEM_OK;
-}
-
 /* Bounds the elimination of one part's sample matrix (n w^2 / 2 multiply-adds, w its band):
  * 5e8 is half a second; larger parts keep the column test only (see find_orphans). */
 #define UNSEEN_MAX_WORK 5e8
@@ -245,7 +189,7 @@ static sem_status find_orphans(sem_object *o, int **ctrl, int **part, int *n, do
     for (int i = 0; i < o->n_parts; ++i) row_start[i + 1] += row_start[i];
     int ordered = 1;
     for (int r = 1; r < J->n_rows; ++r) ordered &= o->d->sample_part[r] >= o->d->sample_part[r - 1];
-    double *floors = part_floors(o->d, o->n_parts);
+    double *floors = sem_error_part_floors(o->d, o->n_parts);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(o->nthreads)
     for (int i = 0; i < o->n_parts; ++i)
         if (ordered && floors)

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "assembly.h"
+#include "shared_kernels.h"
 
 void sem_structured_free(sem_object *o)
 {
