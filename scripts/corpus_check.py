@@ -17,6 +17,7 @@ Writes validation/corpus/results.json and prints a Markdown table (docs/validati
 
 usage: scripts/corpus_check.py [--sem build/sem] [--corpus DIR] [--only TEXT] [--static]
                                [--resolution R] [--timeout S] [--out FILE] [--workdir DIR]
+                               [--resume]
 Python standard library only.
 """
 import argparse
@@ -154,6 +155,8 @@ def main():
     ap.add_argument("--timeout-static", type=int, default=1800)
     ap.add_argument("--out", default=os.path.join(ROOT, "validation", "corpus", "results.json"))
     ap.add_argument("--workdir")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep the results already in --out and run only the files they lack")
     args = ap.parse_args()
     cdir = corpus_dir(args.corpus)
     if not cdir:
@@ -162,8 +165,14 @@ def main():
         manifest = json.load(f)
     base = args.workdir or tempfile.mkdtemp(prefix="sem_corpus_")
     results = []
+    if args.resume and os.path.exists(args.out):
+        with open(args.out) as f:
+            results = json.load(f)
+    done = {r["id"] for r in results}
     for e in manifest:
         if args.only and args.only not in e["id"]:
+            continue
+        if e["id"] in done:
             continue
         path = os.path.join(cdir, e["file"])
         r = {"id": e["id"], "format": e["format"], "units": e["units"].split(" ")[0], "tags": e["tags"]}
@@ -185,6 +194,11 @@ def main():
             print("%-26s refused: %s" % (e["id"], r["error"]), file=sys.stderr)
             continue
         info = json.loads(out)
+        if not info.get("parts") or not info.get("bbox"):
+            r["read"] = "no parts"
+            results.append(r)
+            print("%-26s read, but no part (nothing to simulate)" % e["id"], file=sys.stderr)
+            continue
         r.update({"read": "ok", "parts": info["parts"], "file_dofs": info["dofs"],
                   "read_warnings": len(info.get("warnings", []))})
         r.update(drop(args.sem, path, info, args, work))
