@@ -20,6 +20,14 @@
  *   animation.h   per-frame NURBS, meshes, USD and glTF output
  *   render.h      ray-traced pictures (PNG) and the diagnostic colourings
  *
+ * Constructors. What can fail for a reason the caller should read is made by
+ * `sem_status NAME_create(const DEF *def, ..., T **out, sem_error *err)` (sem_renderer_create,
+ * sem_animation_create, sem_scene_world_create; sem_preprocess and the file readers have the
+ * same shape): *out is set only on SEM_OK, err says why otherwise. Two constructors keep an
+ * older shape, documented at each: sem_model_create() returns an empty model or NULL (out of
+ * memory is its only failure), and sem_world_create(def, err) returns the world or NULL with
+ * err set. Every T made is released by its T_destroy, which accepts NULL.
+ *
  * Build against an installed copy with `pkg-config --cflags --libs sem` or CMake's
  * find_package(sem) and the target sem::sem (docs/library.md).
  */
