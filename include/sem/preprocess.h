@@ -22,6 +22,7 @@
 #define SEM_PREPROCESS_H
 
 #include "sem/model.h"
+#include "sem/polynomial.h"
 #include "sem/sparse.h"
 
 #ifdef __cplusplus
@@ -188,10 +189,6 @@ int sem_preprocess_q_space(const sem_model *model, const sem_preprocess_options 
 int sem_preprocess_shared_fit(const sem_model *model, const sem_preprocess_options *o);
 /* Hash of a model's geometry (degrees, knots, weights, control points, trims) and options. */
 unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preprocess_options *o);
-
-/* Polynomial basis and its gradient at dX (Eq. 3): b has n_basis entries, db 3 x n_basis
- * (db[e * n_basis + k] = d b_k / d X_e). */
-void sem_polynomial_basis(int order, const double dX[3], double *b, double *db);
 
 /* Part `part`'s polynomial coefficients C = Pi_part Q (Eq. 7): Q is n_ctrl x width
  * row-major (width 3 for control points), C is n_basis x width; then part i's map is

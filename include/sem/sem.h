@@ -12,6 +12,7 @@
  *   tessellate.h  triangle meshes                      measure.h   area, bounding box
  *   primitives.h  exact NURBS solids built in code    refine.h    exact knot refinement
  *   sparse.h      compressed sparse rows (the preprocessing data)
+ *   polynomial.h  the polynomial basis of each part's deformation (Eq. 3)
  *   preprocess.h  model -> SEM discretization (paper Sec. 5-7, Alg. 1)
  *   cache.h       a bounded folder of discretizations keyed by model and settings
  *   material.h    hyperelastic energy densities
@@ -45,6 +46,7 @@
 #include "sem/primitives.h"
 #include "sem/refine.h"
 #include "sem/sparse.h"
+#include "sem/polynomial.h"
 #include "sem/preprocess.h"
 #include "sem/cache.h"
 #include "sem/material.h"

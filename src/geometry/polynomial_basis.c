@@ -4,7 +4,7 @@
  * gradient. Shared by the preprocessing (operators) and the simulator, below both, so
  * that neither pulls in the other.
  */
-#include "sem/preprocess.h"
+#include "sem/polynomial.h"
 
 #include <string.h>
 
