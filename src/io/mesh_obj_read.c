@@ -10,6 +10,7 @@
 
 #include "io/read_file.h"
 #include "sem/limits.h"
+#include "util/grow.h"
 
 void sem_triangle_soup_free(sem_triangle_soup *s)
 {
@@ -20,17 +21,7 @@ void sem_triangle_soup_free(sem_triangle_soup *s)
 
 static int grow(void **p, int *cap, int need, size_t elem)
 {
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap : 1024;
-    while (nc < need) {
-        if (nc > (1 << 28)) return 0;
-        nc *= 2;
-    }
-    void *x = realloc(*p, (size_t)nc * elem);
-    if (!x) return 0;
-    *p = x;
-    *cap = nc;
-    return 1;
+    return sem_grow(p, cap, need, elem, 1024, (1 << 29));
 }
 
 /* Is the statement at s (after leading blanks) `word` followed by a blank or the end? */

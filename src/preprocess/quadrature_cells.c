@@ -32,6 +32,7 @@
  * in column order: the result does not depend on the thread count. Nothing depends on the
  * world axes, so the quadrature turns with the object.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +40,7 @@
 #include <lapacke.h>
 
 #include "quadrature_subrays.h"
+#include "util/grow.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
 #define SMALL_PART_CELLS 3.0 /* a part asks for cells of at most its size / this */
@@ -86,14 +88,7 @@ typedef struct cell_grid {
 
 static int grow(void **p, int *cap, int need, size_t elem)
 {
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap : 64;
-    while (nc < need) nc *= 2;
-    void *q = realloc(*p, (size_t)nc * elem);
-    if (!q) return 0;
-    *p = q;
-    *cap = nc;
-    return 1;
+    return sem_grow(p, cap, need, elem, 64, INT_MAX);
 }
 
 static int push_entry(column_buffers *b, int cell, int part, double len)

@@ -56,9 +56,12 @@
  */
 #include "quadrature_subrays.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "util/grow.h"
 
 /* Levels of quarters below the base squares. */
 #define MAX_DEPTH 2
@@ -73,14 +76,7 @@ sem_subray_settings sem_subray_default_settings(void)
 
 static int grow(void **p, int *cap, int need, size_t elem)
 {
-    if (need <= *cap) return 1;
-    int nc = *cap ? *cap : 64;
-    while (nc < need) nc *= 2;
-    void *q = realloc(*p, (size_t)nc * elem);
-    if (!q) return 0;
-    *p = q;
-    *cap = nc;
-    return 1;
+    return sem_grow(p, cap, need, elem, 64, INT_MAX);
 }
 
 /* Column ci + n[1] cj. */

@@ -1,0 +1,17 @@
+/* grow.c - see grow.h. */
+#include "grow.h"
+
+#include <stdlib.h>
+
+int sem_grow(void **p, int *cap, int need, size_t elem, int first, int max)
+{
+    if (need <= *cap) return 1;
+    if (need > max) return 0;
+    int nc = *cap ? *cap : first;
+    while (nc < need) nc = nc > max / 2 ? max : 2 * nc;
+    void *q = realloc(*p, (size_t)nc * elem);
+    if (!q) return 0;
+    *p = q;
+    *cap = nc;
+    return 1;
+}
