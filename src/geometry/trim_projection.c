@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/seam.h"
 #include "sem/nurbs.h"
 
 #define SAMPLES_PER_SPAN_MIN 4
@@ -116,25 +117,6 @@ sem_trim_projection_settings sem_default_trim_projection_settings(const sem_surf
     double size = surface_size(s);
     sem_trim_projection_settings o = {2e-5 * size, 1e-2 * size, 1e-4 * size};
     return o;
-}
-
-/* S(u0, v) == S(u1, v) along v (dir 0), or S(u, v0) == S(u, v1) along u (dir 1) */
-static int is_closed(const sem_surface *s, int dir, double tol)
-{
-    for (int k = 0; k <= 8; ++k) {
-        double a[3], b[3];
-        if (dir == 0) {
-            double v = s->v0 + (s->v1 - s->v0) * k / 8.0;
-            sem_surface_eval(s, s->u0, v, a, NULL, NULL, NULL);
-            sem_surface_eval(s, s->u1, v, b, NULL, NULL, NULL);
-        } else {
-            double u = s->u0 + (s->u1 - s->u0) * k / 8.0;
-            sem_surface_eval(s, u, s->v0, a, NULL, NULL, NULL);
-            sem_surface_eval(s, u, s->v1, b, NULL, NULL, NULL);
-        }
-        if (dist3(a, b) > tol) return 0;
-    }
-    return 1;
 }
 
 /* The line u = const (dir 0: x_u = 0 along it, a pole at this v) is collapsed when the
@@ -469,8 +451,8 @@ static sem_status project_pass(const sem_surface_sampler *sampler, const sem_cur
     c.max_distance = settings->max_distance;
     c.max_gap = settings->max_gap;
     c.unwrap = unwrap;
-    c.closed[0] = is_closed(c.s, 0, c.tol);
-    c.closed[1] = is_closed(c.s, 1, c.tol);
+    c.closed[0] = sem_surface_is_closed(c.s, 0, c.tol);
+    c.closed[1] = sem_surface_is_closed(c.s, 1, c.tol);
     c.eps[0] = 1e-9 * (c.s->u1 - c.s->u0);
     c.eps[1] = 1e-9 * (c.s->v1 - c.s->v0);
 
@@ -637,7 +619,7 @@ sem_status sem_trim_project_loop(const sem_surface_sampler *sampler, const sem_c
                                  &join_failed, err);
     const sem_surface *s = sampler->surface;
     if (st == SEM_ERR_INVALID && join_failed &&
-        (is_closed(s, 0, settings->tolerance) || is_closed(s, 1, settings->tolerance))) {
+        (sem_surface_is_closed(s, 0, settings->tolerance) || sem_surface_is_closed(s, 1, settings->tolerance))) {
         /* A loop that crosses the seam of a closed surface jumps by a period where it does,
          * and cannot close in the domain: projected again, each point unwrapped to the
          * period nearest the point before it (as Open CASCADE's shape fixing unwraps its
