@@ -11,6 +11,7 @@
 #include <lapacke.h>
 
 #include "loads.h"
+#include "shared_kernels.h"
 
 static int in_box(const double box[6], const double X[3])
 {
@@ -297,26 +298,8 @@ void sem_pins_add_pair_blocks(const sem_object *o, double *pairs)
 static void touched_coefficients(const sem_object *o, const double *x, double *z)
 {
     const sem_pins *p = o->pins;
-    int m = o->m;
-    for (int t = 0; t < p->n_touched; ++t) {
-        int i = p->touched[t], g = o->d->part_origin[i];
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        double *zi = z + 3 * (size_t)t * m;
-        for (int k = 0; k < m; ++k) {
-            const double *row = o->pi_dense[i] + (size_t)k * n;
-            double a0 = 0, a1 = 0, a2 = 0;
-            for (size_t l = 0; l < n; ++l) {
-                const double *xc = x + 3 * (size_t)ctrl[l];
-                a0 += row[l] * xc[0];
-                a1 += row[l] * xc[1];
-                a2 += row[l] * xc[2];
-            }
-            zi[3 * k] = a0;
-            zi[3 * k + 1] = a1;
-            zi[3 * k + 2] = a2;
-        }
-    }
+    for (int t = 0; t < p->n_touched; ++t)
+        sem_part_rows_multiply(o, p->touched[t], o->pi_dense[p->touched[t]], o->m, x, z + 3 * (size_t)t * o->m);
 }
 
 /* y += c Pi_i^T zg_i over the touched parts. */

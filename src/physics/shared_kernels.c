@@ -48,29 +48,32 @@ const double *sem_centered(sem_object *o, const double *q)
     return o->qc;
 }
 
+void sem_part_rows_multiply(const sem_object *o, int i, const double *rows, int n_rows, const double *x,
+                            double *zi)
+{
+    int g = o->d->part_origin[i];
+    size_t n = sem_group_size(o, g);
+    const int *ctrl = o->group_ctrl + o->group_start[g];
+    for (int k = 0; k < n_rows; ++k) {
+        const double *row = rows + (size_t)k * n;
+        double s0 = 0, s1 = 0, s2 = 0;
+        for (size_t j = 0; j < n; ++j) {
+            const double *xc = x + 3 * (size_t)ctrl[j];
+            s0 += row[j] * xc[0];
+            s1 += row[j] * xc[1];
+            s2 += row[j] * xc[2];
+        }
+        zi[k * 3 + 0] = s0;
+        zi[k * 3 + 1] = s1;
+        zi[k * 3 + 2] = s2;
+    }
+}
+
 void sem_shared_coefficients(const sem_object *o, const double *x, double *z)
 {
     int ma = o->ma;
 #pragma omp parallel for schedule(static) num_threads(o->nthreads)
-    for (int i = 0; i < o->n_parts; ++i) {
-        int g = o->d->part_origin[i];
-        size_t n = sem_group_size(o, g);
-        const int *ctrl = o->group_ctrl + o->group_start[g];
-        double *zi = z + (size_t)i * ma * 3;
-        for (int k = 0; k < ma; ++k) {
-            const double *row = o->pi_shared[i] + (size_t)k * n;
-            double s0 = 0, s1 = 0, s2 = 0;
-            for (size_t j = 0; j < n; ++j) {
-                const double *xc = x + 3 * (size_t)ctrl[j];
-                s0 += row[j] * xc[0];
-                s1 += row[j] * xc[1];
-                s2 += row[j] * xc[2];
-            }
-            zi[k * 3 + 0] = s0;
-            zi[k * 3 + 1] = s1;
-            zi[k * 3 + 2] = s2;
-        }
-    }
+    for (int i = 0; i < o->n_parts; ++i) sem_part_rows_multiply(o, i, o->pi_shared[i], ma, x, z + (size_t)i * ma * 3);
 }
 
 void sem_shared_add_transpose(const sem_object *o, const double *z, double *y)

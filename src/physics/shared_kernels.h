@@ -13,6 +13,10 @@
 /* Part pair pr is a <= b and shares a quadrature point: its stiffness block Kz is formed
  * (W rows list parts in increasing order). */
 int sem_pair_has_points(const sem_object *o, int pr);
+/* zi = rows x over part i's group (n_rows rows of the group's size, row-major; zi n_rows x 3,
+ * coordinates interleaved): Pi_i x with rows pi_dense[i], pi_shared x with pi_shared[i]. */
+void sem_part_rows_multiply(const sem_object *o, int i, const double *rows, int n_rows, const double *x,
+                            double *zi);
 /* z = pi_shared x (per part ma x 3, coordinates interleaved), x over all control points. */
 void sem_shared_coefficients(const sem_object *o, const double *x, double *z);
 /* y += pi_shared^T z. */
