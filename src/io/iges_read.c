@@ -1116,19 +1116,27 @@ static sem_status read_arc(iges_reader *r, int idx, sem_curve *c)
     return SEM_OK;
 }
 
+/* What every curve and surface entity does first: refuse a cycle or too deep a nesting,
+ * count the conversion (SEM_MAX_* budgets), and compose its own transform with its parent's
+ * into m. */
+static sem_status enter_entity(iges_reader *r, int idx, const double *parent, int depth, double m[12])
+{
+    if (depth > IGES_MAX_DEPTH || r->entries[idx].busy)
+        return entity_error(r, idx, 0, "entity references itself (cycle or nesting deeper than "
+                                       "%d)", IGES_MAX_DEPTH);
+    sem_status st = count_conversion(r, idx);
+    if (st != SEM_OK) return st;
+    return own_xform(r, idx, parent, m);
+}
+
 /* Reads any supported curve entity as one or more NURBS curves (a composite curve gives
  * its members in order), in the coordinates of `parent` o (the curve's own transform). */
 static sem_status read_curves(iges_reader *r, int idx, const double *parent, int depth,
                               curve_list *out)
 {
     iges_entry *e = &r->entries[idx];
-    if (depth > IGES_MAX_DEPTH || e->busy)
-        return entity_error(r, idx, 0, "entity references itself (cycle or nesting deeper than "
-                                       "%d)", IGES_MAX_DEPTH);
-    sem_status st = count_conversion(r, idx);
-    if (st != SEM_OK) return st;
     double m[12];
-    st = own_xform(r, idx, parent, m);
+    sem_status st = enter_entity(r, idx, parent, depth, m);
     if (st != SEM_OK) return st;
     sem_curve c;
     memset(&c, 0, sizeof c);
@@ -1658,13 +1666,8 @@ static sem_status read_surface(iges_reader *r, int idx, const double *parent, in
                                sem_part *part)
 {
     iges_entry *e = &r->entries[idx];
-    if (depth > IGES_MAX_DEPTH || e->busy)
-        return entity_error(r, idx, 0, "entity references itself (cycle or nesting deeper than "
-                                       "%d)", IGES_MAX_DEPTH);
-    sem_status st = count_conversion(r, idx);
-    if (st != SEM_OK) return st;
     double m[12];
-    st = own_xform(r, idx, parent, m);
+    sem_status st = enter_entity(r, idx, parent, depth, m);
     if (st != SEM_OK) return st;
     e->busy = 1;
     switch (e->type) {
