@@ -326,6 +326,9 @@ typedef struct sem_world_counters {
                                      definite, so that went back to the projected one */
     long unconverged_solves;      /* Newton solves kept without reaching the tolerance
                                      (sem_world_def.accept_unconverged) */
+    long newton_stalls;           /* Newton solves ended as converged because their full steps
+                                     stopped moving while the gradient stayed at its round-off
+                                     (src/physics/newton.c, NEWTON_STALL_*) */
     long regroupings;             /* times the objects were put in new systems because the
                                      islands of objects that may touch changed */
     int systems;                  /* linear systems the last step solved (one per island) */
