@@ -1983,9 +1983,12 @@ static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *
         if (param_ptr(r, p, 4, 1, &cptr) != SEM_OK || cptr < 0) continue;
         curve_list c;
         memset(&c, 0, sizeof c);
-        if (read_curves(r, cptr, m, depth + 1, &c) == SEM_OK)
-            for (int j = 0; j < c.n; ++j)
-                if (list_push(r, hint, &c.c[j]) != SEM_OK) sem_curve_free(&c.c[j]);
+        if (read_curves(r, cptr, m, depth + 1, &c) != SEM_OK) {
+            list_free(&c); /* a composite that failed part-way keeps the members it read */
+            continue;
+        }
+        for (int j = 0; j < c.n; ++j)
+            if (list_push(r, hint, &c.c[j]) != SEM_OK) sem_curve_free(&c.c[j]);
         free(c.c);
     }
 }
