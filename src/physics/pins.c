@@ -100,6 +100,7 @@ sem_status sem_pins_init(sem_object *o, const sem_object_def *def, sem_error *er
      * an old file) gets the cell of its mean volume. */
     double h = d->quad_spacing > 0 ? d->quad_spacing : (d->n_quad > 0 ? cbrt(d->volume / d->n_quad) : d->length_scale);
     if (!(h > 0)) h = 1;
+    p->spacing = h;
     p->stiffness = SEM_PIN_STIFFNESS * largest_modulus(o) / (h * h);
     /* A point lies in the last region whose box holds it (as a later prescribe group wins
      * for control points). Count first, then fill. */
@@ -172,9 +173,8 @@ sem_status sem_pins_init(sem_object *o, const sem_object_def *def, sem_error *er
     return SEM_OK;
 }
 
-/* Adds point X (weight w, the part's blending weight wi) to part i's form H += w e e^T,
- * e = wi b(X - Xbar_i). */
-static void add_form(const sem_object *o, int i, double wi, const double X[3], double w, double *H)
+/* Adds point X (weight w) to part i's form H += w e e^T, e = b(X - Xbar_i). */
+static void add_form(const sem_object *o, int i, const double X[3], double w, double *H)
 {
     const sem_discretization *d = o->d;
     const int m = o->m;
@@ -182,7 +182,7 @@ static void add_form(const sem_object *o, int i, double wi, const double X[3], d
     double dX[3] = {X[0] - Xb[0], X[1] - Xb[1], X[2] - Xb[2]}, e[10];
     sem_polynomial_basis(d->order, dX, e, NULL);
     for (int r = 0; r < m; ++r)
-        for (int c = 0; c < m; ++c) H[r * m + c] += w * wi * wi * e[r] * e[c];
+        for (int c = 0; c < m; ++c) H[r * m + c] += w * e[r] * e[c];
 }
 
 void sem_pins_held_parts(const sem_object *o, const sem_object_def *def)
@@ -200,33 +200,29 @@ void sem_pins_held_parts(const sem_object *o, const sem_object_def *def)
     double *lo = malloc((size_t)np * 3 * sizeof(double) + 1), *hi = malloc((size_t)np * 3 * sizeof(double) + 1);
     if (!all || !held || !total || !outside || !lo || !hi) goto done; /* a check only */
     for (int i = 0; i < 3 * np; ++i) lo[i] = INFINITY, hi[i] = -INFINITY;
-    double h = d->quad_spacing > 0 ? d->quad_spacing : (d->n_quad > 0 ? cbrt(d->volume / d->n_quad) : d->length_scale);
-    /* held: the anchored points (quadrature points and samples, through their blending
-     * weights); all: the part's own surface (its samples, its own polynomial), which is what
-     * the user sees move */
-    for (int t = 0; t < 2; ++t) {
-        const sem_csr *W = t ? &d->W_samples : &d->W;
-        int n = t ? d->n_samples : d->n_quad;
-        const double *XX = t ? d->sample_X : d->quad_X;
-        for (int q = 0; q < n; ++q) {
-            const double *X = XX + 3 * (size_t)q;
-            double w = t ? 0.5 * h * d->sample_area[q] : d->quad_volume[q];
-            if (!(w > 0)) continue;
-            int in = 0;
-            for (int r = 0; r < def->n_pin_regions && !in; ++r) in = in_box(def->pin_regions[r].box, X);
-            if (t) {
-                int i = d->sample_part[q];
-                add_form(o, i, 1, X, w, all + (size_t)i * mm);
-                total[i] += w;
-                if (!in) outside[i] += w;
-                for (int k = 0; k < 3; ++k) {
-                    lo[3 * i + k] = fmin(lo[3 * i + k], X[k]);
-                    hi[3 * i + k] = fmax(hi[3 * i + k], X[k]);
-                }
-            }
-            if (!in) continue;
-            for (int e = W->row_start[q]; e < W->row_start[q + 1]; ++e)
-                if (W->val[e] > 0) add_form(o, W->col[e], W->val[e], X, w, held + (size_t)W->col[e] * mm);
+    /* held: the anchored points (quadrature points and samples), from their basis rows as
+     * sem_pins_init keeps them (w_ai b(X_a - Xbar_i), weight k w_a) */
+    for (int a = 0; a < p->n_points; ++a)
+        for (int e = p->start[a]; e < p->start[a + 1]; ++e) {
+            const double *b = p->basis + (size_t)e * m;
+            double *H = held + (size_t)p->part[e] * mm, w = p->weight[a] / p->stiffness;
+            for (int r = 0; r < m; ++r)
+                for (int c = 0; c < m; ++c) H[r * m + c] += w * b[r] * b[c];
+        }
+    /* all: each part's own surface (its samples, its own polynomial), which is what the user
+     * sees move, with the samples' anchor weight a_s h / 2 */
+    for (int q = 0; q < d->n_samples; ++q) {
+        const double *X = d->sample_X + 3 * (size_t)q;
+        double w = 0.5 * p->spacing * d->sample_area[q];
+        if (!(w > 0)) continue;
+        int in = 0, i = d->sample_part[q];
+        for (int r = 0; r < def->n_pin_regions && !in; ++r) in = in_box(def->pin_regions[r].box, X);
+        add_form(o, i, X, w, all + (size_t)i * mm);
+        total[i] += w;
+        if (!in) outside[i] += w;
+        for (int k = 0; k < 3; ++k) {
+            lo[3 * i + k] = fmin(lo[3 * i + k], X[k]);
+            hi[3 * i + k] = fmax(hi[3 * i + k], X[k]);
         }
     }
     /* Part i is held whole when every motion of its polynomial costs the anchor more than the

@@ -60,6 +60,7 @@ typedef struct sem_pins {
     int *touched;
     int *touched_slot;  /* per part: its index in touched, or -1 */
     double stiffness;   /* k */
+    double spacing;     /* h, the quadrature spacing k is scaled by */
     int moves;          /* 1: some anchored point follows a motion */
     /* A box that holds all of a part's polynomial while the part's material reaches beyond it
      * (sem_pins_held_parts): the part with the most material outside, -1 when none. */
