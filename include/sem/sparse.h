@@ -33,6 +33,8 @@ sem_status sem_csr_from_triplets(sem_csr *m, int n_rows, int n_cols, size_t n, c
 /* y = A x (x has n_cols entries, y n_rows). stride: apply to `width` interleaved columns,
  * i.e. X is n_cols x width row-major (e.g. width 3 for control points). */
 void sem_csr_multiply(const sem_csr *a, const double *x, int width, double *y);
+/* The same with its rows split over `threads` OpenMP threads (the same bits on any count). */
+void sem_csr_multiply_threads(const sem_csr *a, const double *x, int width, double *y, int threads);
 /* y = A^T x, same conventions. */
 void sem_csr_multiply_transpose(const sem_csr *a, const double *x, int width, double *y);
 size_t sem_csr_nnz(const sem_csr *m);

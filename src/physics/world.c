@@ -331,7 +331,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
                 sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
                 goto fail;
             }
-            sem_csr_multiply(&d->Gamma, o->q, 3, xp);
+            sem_csr_multiply_threads(&d->Gamma, o->q, 3, xp, o->nthreads);
             for (int p = 0; p < o->n_quad; ++p)
                 for (int k = 0; k < 3; ++k) com[k] += o->point_rho_vol[p] * xp[3 * p + k];
             for (int k = 0; k < 3; ++k) com[k] /= o->mass;
@@ -507,26 +507,6 @@ void sem_world_object_set_state(sem_world *w, int i, const double *q, const doub
     if (v) memcpy(o->v, v, n * sizeof(double));
 }
 
-/* y = Gamma x (the SEM map at the quadrature points, 3 columns), rows split over the
- * object's threads: each row is its own sum, so the bits do not depend on the count. */
-static void gamma_multiply(const sem_object *o, const double *x, double *y)
-{
-    const sem_csr *G = &o->d->Gamma;
-#pragma omp parallel for schedule(static) num_threads(o->nthreads)
-    for (int r = 0; r < G->n_rows; ++r) {
-        double s0 = 0, s1 = 0, s2 = 0;
-        for (int k = G->row_start[r]; k < G->row_start[r + 1]; ++k) {
-            const double *xc = x + 3 * (size_t)G->col[k];
-            s0 += G->val[k] * xc[0];
-            s1 += G->val[k] * xc[1];
-            s2 += G->val[k] * xc[2];
-        }
-        y[3 * (size_t)r] = s0;
-        y[3 * (size_t)r + 1] = s1;
-        y[3 * (size_t)r + 2] = s2;
-    }
-}
-
 void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
 {
     sem_object *o = w->objects[i];
@@ -543,8 +523,8 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
         free(tmp);
         return;
     }
-    gamma_multiply(o, o->q, x);
-    gamma_multiply(o, o->v, v);
+    sem_csr_multiply_threads(&o->d->Gamma, o->q, 3, x, o->nthreads);
+    sem_csr_multiply_threads(&o->d->Gamma, o->v, 3, v, o->nthreads);
     const double *g = w->def.gravity;
     for (int p = 0; p < o->n_quad; ++p) {
         double rv = o->point_rho_vol[p];

@@ -111,8 +111,10 @@ sem_status sem_csr_from_triplets(sem_csr *m, int n_rows, int n_cols, size_t n, c
     return SEM_OK;
 }
 
-void sem_csr_multiply(const sem_csr *a, const double *x, int width, double *y)
+void sem_csr_multiply_threads(const sem_csr *a, const double *x, int width, double *y, int threads)
 {
+    /* each row is its own sum in column order: the same bits on any thread count */
+#pragma omp parallel for schedule(static) num_threads(threads > 1 ? threads : 1) if (threads > 1)
     for (int r = 0; r < a->n_rows; ++r) {
         double *yr = y + (size_t)r * width;
         for (int w = 0; w < width; ++w) yr[w] = 0.0;
@@ -121,6 +123,11 @@ void sem_csr_multiply(const sem_csr *a, const double *x, int width, double *y)
             for (int w = 0; w < width; ++w) yr[w] += a->val[k] * xc[w];
         }
     }
+}
+
+void sem_csr_multiply(const sem_csr *a, const double *x, int width, double *y)
+{
+    sem_csr_multiply_threads(a, x, width, y, 1);
 }
 
 void sem_csr_multiply_transpose(const sem_csr *a, const double *x, int width, double *y)
