@@ -466,7 +466,7 @@ static void test_scene(void)
                        "colliders[0].friction: must be >= 0");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"colliders\": [{\"plane\": {}, \"model\": \"quad.obj\"}]}",
                        "colliders[0]: needs exactly one of");
-    expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"self\": true}}", "contact.self");
+    expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"self\": 1}}", "contact.self");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"stiffness\": -3}}", "contact.stiffness: must be positive");
     expect_scene_error(dir, "{" BOX_OBJECT ", \"contact\": {\"stifness\": 3}}", "contact: unknown key \"stifness\"");
     expect_scene_error(dir,

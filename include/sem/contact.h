@@ -12,7 +12,8 @@
  *
  * Usage: the world definition's contact settings (sem_world_def.contact) hold the defaults
  * below; sem_world_add_collider adds a static collider; contact between objects is on
- * whenever the world has two objects or more.
+ * whenever the world has two objects or more, and self-contact (sem_contact_def.self)
+ * wherever contact is on.
  */
 #ifndef SEM_CONTACT_H
 #define SEM_CONTACT_H
@@ -34,7 +35,12 @@ typedef struct sem_contact_def {
     /* Distance from a surface at which the springs start (m); <= 0: 1e-3 L of each object.
      * A resting object floats about this far above what it rests on. */
     double thickness;
-    int self;              /* 1: an object's parts push each other too (not implemented) */
+    /* Self-contact: an object's surface is kept out of itself, away from where it meets
+     * itself at rest (a point never collides with its own surface within twice the search
+     * radius, 2 (thickness + 0.05 L), of where it is at rest). 0: on wherever contact is on
+     * (colliders, or two objects or more); 1: on, and contact is on for a lone object too
+     * (a mat twisted in the air); -1: off. */
+    int self;
     int disabled;          /* 1: no contact at all (objects pass through each other) */
     /* Friction's smoothing velocity (m/s; IPC's epsilon_v): below it, sticking is an
      * ultra-stiff spring; a held object creeps at about this speed. <= 0: 1e-3 m/s. */
@@ -68,6 +74,7 @@ sem_collider_def sem_default_collider_def(void);
 /* What the last step's contact did (sem_world_contact_stats). */
 typedef struct sem_contact_stats {
     int contacts;     /* contact points pushed at the end of the last step */
+    int self_contacts; /* of which against their own object's surface (self-contact) */
     double min_gap;   /* smallest signed distance of a collision point to another surface
                          it is near (m; negative: penetration); +inf when none is near */
     double seconds;   /* wall time of the last step spent in contact */

@@ -83,7 +83,7 @@ static cJSON *vec3(const double v[3])
 /* The numbers of one frame in summary.json, in this order in a state file. */
 enum { STAT_TIME, STAT_KINETIC, STAT_ELASTIC, STAT_GRAVITY, STAT_ERROR, STAT_COM,
        STAT_LINEAR = STAT_COM + 3, STAT_ANGULAR = STAT_LINEAR + 3, STAT_CONTACTS = STAT_ANGULAR + 3,
-       STAT_MIN_GAP, STAT_COUNT };
+       STAT_MIN_GAP, STAT_SELF_CONTACTS, STAT_COUNT };
 
 typedef struct run_state {
     sem_scene *scene;
@@ -152,6 +152,7 @@ static void frame_stats(run_state *r, double t, double *x)
     sem_world_contact_stats(r->world, &cs);
     x[STAT_CONTACTS] = cs.contacts;
     x[STAT_MIN_GAP] = cs.min_gap;
+    x[STAT_SELF_CONTACTS] = cs.self_contacts;
 }
 
 /* "part 3 (Face3)" or "part 3" */
@@ -236,6 +237,7 @@ static void add_frame_stats(run_state *r, const double *x)
     cJSON_AddItemToObject(f, "linear_momentum", vec3(x + STAT_LINEAR));
     cJSON_AddItemToObject(f, "angular_momentum", vec3(x + STAT_ANGULAR));
     cJSON_AddNumberToObject(f, "contacts", x[STAT_CONTACTS]);
+    cJSON_AddNumberToObject(f, "self_contacts", x[STAT_SELF_CONTACTS]);
     if (isfinite(x[STAT_MIN_GAP]))
         cJSON_AddNumberToObject(f, "min_gap", x[STAT_MIN_GAP]);
     else

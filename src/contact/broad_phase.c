@@ -148,6 +148,13 @@ static double box_dist2(const sem_bvh_node *n, const double p[3])
 int sem_bvh_closest(const sem_bvh *bvh, const double *vertices, const int *triangles, const double p[3],
                     double max_dist2, sem_tri_closest *out)
 {
+    return sem_bvh_closest_except(bvh, vertices, triangles, p, max_dist2, NULL, NULL, out);
+}
+
+int sem_bvh_closest_except(const sem_bvh *bvh, const double *vertices, const int *triangles, const double p[3],
+                           double max_dist2, int (*skip)(int triangle, void *context), void *context,
+                           sem_tri_closest *out)
+{
     if (bvh->n_triangles <= 0) return -1;
     int stack[128], top = 0, best = -1;
     double best2 = max_dist2;
@@ -162,7 +169,7 @@ int sem_bvh_closest(const sem_bvh *bvh, const double *vertices, const int *trian
                 sem_tri_closest c;
                 sem_point_triangle_closest(p, vertices + 3 * (size_t)v[0], vertices + 3 * (size_t)v[1],
                                            vertices + 3 * (size_t)v[2], &c);
-                if (c.dist2 < best2) {
+                if (c.dist2 < best2 && !(skip && skip(tri, context))) {
                     best2 = c.dist2;
                     best = tri;
                     *out = c;

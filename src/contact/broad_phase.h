@@ -36,5 +36,10 @@ void sem_bvh_free(sem_bvh *bvh);
 /* The triangle nearest p with squared distance < max_dist2, or -1; *out its closest point. */
 int sem_bvh_closest(const sem_bvh *bvh, const double *vertices, const int *triangles, const double p[3],
                     double max_dist2, sem_tri_closest *out);
+/* The same among the triangles for which skip(triangle, context) is 0 (skip is asked only
+ * of triangles nearer than the best so far; NULL: none is skipped). */
+int sem_bvh_closest_except(const sem_bvh *bvh, const double *vertices, const int *triangles, const double p[3],
+                           double max_dist2, int (*skip)(int triangle, void *context), void *context,
+                           sem_tri_closest *out);
 
 #endif

@@ -234,6 +234,7 @@ void sem_collision_mesh_free(sem_collision_mesh *m)
     free(m->area);
     free(m->triangles);
     free(m->x);
+    free(m->x0);
     free(m->pseudo_normal);
     free(m->face_normal);
     free(m->weld);
@@ -336,6 +337,9 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
         double area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         for (int k = 0; k < 3; ++k) out->area[tri[k]] += area / 3;
     }
+    out->x0 = malloc(3 * (size_t)out->n_points * sizeof(double) + 1);
+    if (!out->x0) goto nomem;
+    memcpy(out->x0, out->x, 3 * (size_t)out->n_points * sizeof(double));
     st = sem_bvh_build(&out->bvh, out->x, out->triangles, out->n_triangles, err);
     goto done;
 nomem:

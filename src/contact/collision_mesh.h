@@ -30,6 +30,7 @@ typedef struct sem_collision_mesh {
     int n_triangles;
     int *triangles;        /* 3 point indices per triangle */
     double *x;             /* current positions (sem_collision_mesh_update) */
+    double *x0;            /* rest positions (what self-contact's exclusion rule measures) */
     double *face_normal;   /* current unit triangle normals (outward) */
     double *pseudo_normal; /* current angle-weighted vertex normals over the welded point */
     int *weld;             /* the point's representative: points that coincide at rest */
@@ -44,8 +45,9 @@ typedef struct sem_collision_mesh {
 sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_collision_mesh *out,
                                     sem_error *err);
 void sem_collision_mesh_free(sem_collision_mesh *m);
-/* x = J q for every point; with between (contact between objects, the only user of the
- * normals and of this mesh's tree) also the face and vertex normals and the tree's boxes.
+/* x = J q for every point; with between (contact between objects or of an object with
+ * itself, the only users of the normals and of this mesh's tree) also the face and vertex
+ * normals and the tree's boxes.
  * The mesh as built has normals at the rest shape. */
 void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int between);
 /* The outward direction at the closest feature of triangle t (narrow_phase.h: feature,

@@ -21,6 +21,11 @@
 #define SEARCH_DEPTH 0.05          /* x L: how deep a point may be and still be pushed out */
 #define DEFAULT_FRICTION_VELOCITY 1e-3
 #define MAX_WEIGHTS 192            /* a point's row plus a triangle's three rows */
+/* Self-contact's exclusion rule: a point never collides with the part of its own object's
+ * surface that lies within SELF_EXCLUSION x the search radius of it at rest (its own
+ * neighbourhood, the other sheet of a thin wall, the other side of a seam). Twice the
+ * search radius: at rest no point is within reach of a surface it may collide with. */
+#define SELF_EXCLUSION 2.0
 
 typedef struct collider {
     sem_collider_type type;
@@ -97,7 +102,9 @@ sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem
     *out = NULL;
     if (!isfinite(def->stiffness) || !isfinite(def->thickness) || !isfinite(def->friction_velocity))
         return sem_error_set(err, SEM_ERR_INVALID, "contact settings must be finite");
-    if (def->self) return sem_error_set(err, SEM_ERR_INVALID, "contact: self-contact is not implemented yet");
+    if (def->self < -1 || def->self > 1)
+        return sem_error_set(err, SEM_ERR_INVALID, "contact: self must be -1 (off), 0 (the default: on) or 1 (got %d)",
+                             def->self);
     if (def->resolution > 64)
         return sem_error_set(err, SEM_ERR_INVALID, "contact resolution must be at most 64 (got %d)", def->resolution);
     sem_contact *c = calloc(1, sizeof *c);
@@ -312,7 +319,7 @@ int sem_contact_between_objects(const sem_contact *c) { return !c->def.disabled 
 
 int sem_contact_active(const sem_contact *c)
 {
-    return !c->def.disabled && (c->n_colliders > 0 || c->n_objects >= 2);
+    return !c->def.disabled && (c->n_colliders > 0 || c->n_objects >= 2 || (c->def.self > 0 && c->n_objects > 0));
 }
 
 const sem_point_terms *sem_contact_terms(const sem_contact *c) { return &c->terms; }
@@ -321,6 +328,27 @@ void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out) { *out 
 
 /* ---------------------------------------------------------------------------------- */
 /* detection                                                                           */
+
+/* Self-contact on (sem_contact_def.self: 0 the default, on; -1 off). */
+static int self_on(const sem_contact *c) { return !c->def.disabled && c->def.self >= 0; }
+
+/* Self-contact's exclusion rule (SELF_EXCLUSION): is triangle t of the mesh within the
+ * excluded rest distance of the point? */
+typedef struct self_exclusion {
+    const sem_collision_mesh *mesh;
+    const double *point;   /* the point's rest position */
+    double radius2;
+} self_exclusion;
+
+static int self_excluded(int t, void *context)
+{
+    const self_exclusion *e = context;
+    const int *v = e->mesh->triangles + 3 * (size_t)t;
+    const double *x0 = e->mesh->x0;
+    sem_tri_closest cl;
+    sem_point_triangle_closest(e->point, x0 + 3 * (size_t)v[0], x0 + 3 * (size_t)v[1], x0 + 3 * (size_t)v[2], &cl);
+    return !(cl.dist2 >= e->radius2); /* a degenerate triangle (NaN distance) is left out too */
+}
 
 /* contact_object of each of the system's objects */
 static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err)
@@ -394,6 +422,26 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         r.mu = sqrt(co->friction * col->friction);
         out[n++] = r;
     }
+    if (self_on(c)) {
+        /* the object's own surface beyond the exclusion rule; within the search radius only
+         * (self-contact needs no coupling blocks, the margin's only use) */
+        self_exclusion ex = {m, m->x0 + 3 * (size_t)p, SELF_EXCLUSION * SELF_EXCLUSION * radius * radius};
+        sem_tri_closest cl;
+        int t = sem_bvh_closest_except(&m->bvh, m->x, m->triangles, x, fmin(reach2, radius * radius), self_excluded,
+                                       &ex, &cl);
+        if (t >= 0) {
+            contact_rec r = {k, p, k, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
+            double outward[3];
+            sem_collision_mesh_outward(m, t, cl.feature, cl.index, outward);
+            r.d = sem_signed_distance(x, cl.point, outward, r.n);
+            if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
+            if (r.d < th + margin * radius) {
+                r.stiffness = own_stiffness * m->area[p];
+                r.mu = co->friction;
+                out[n++] = r;
+            }
+        }
+    }
     if (s->n_objects < 2) return n;
     for (int j = 0; j < s->n_objects; ++j) {
         if (j == k) continue;
@@ -427,10 +475,10 @@ static sem_status detect(sem_contact *c, const sem_system *s, const double *q, d
     c->n_recs = 0;
     c->min_gap = INFINITY;
     if (c->def.disabled) return SEM_OK;
-    int between = s->n_objects >= 2;
+    int between = s->n_objects >= 2 || self_on(c);
     for (int k = 0; k < s->n_objects; ++k)
         sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
-    int per_point = c->n_colliders + s->n_objects - 1;
+    int per_point = c->n_colliders + s->n_objects - 1 + self_on(c);
     if (per_point <= 0) return SEM_OK;
     int nthreads = s->n_objects > 0 ? s->objects[0]->nthreads : 1;
     for (int k = 0; k < s->n_objects; ++k) {
@@ -645,7 +693,7 @@ static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_erro
     c->n_couplings = 0;
     for (int i = 0; i < c->n_recs; ++i) {
         const contact_rec *r = &c->recs[i];
-        if (r->other < 0) continue;
+        if (r->other < 0 || r->other == r->k) continue; /* self-contact: the object's own blocks */
         const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
         const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
         int ga = s->objects[r->k]->ctrl_group[m->row_ctrl[m->row_start[r->point]]];
@@ -809,6 +857,7 @@ void sem_contact_begin_world_step(sem_contact *c)
 {
     c->stats.seconds = 0;
     c->stats.contacts = 0;
+    c->stats.self_contacts = 0;
     c->stats.min_gap = INFINITY;
 }
 
@@ -871,6 +920,7 @@ void sem_contact_end_step(sem_contact *c, const sem_system *s)
     sem_error err;
     if (q && detect(c, s, q, 0, &err) == SEM_OK) {
         c->stats.contacts += c->n_recs;
+        for (int i = 0; i < c->n_recs; ++i) c->stats.self_contacts += c->recs[i].other == c->recs[i].k;
         c->stats.min_gap = fmin(c->stats.min_gap, c->min_gap);
     }
     free(q);

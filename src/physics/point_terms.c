@@ -129,9 +129,16 @@ static int term_couplings(const sem_system *s, const sem_point_weight *wt, int c
             coupling[i * m + j] = -1;
             if (i == j) continue;
             const sem_point_weight *a = &wt[first[i]], *b = &wt[first[j]];
-            if (a->object == b->object) return 0; /* two groups of one object: self-contact */
-            if (a->object > b->object) continue;
             int ga = s->objects[a->object]->ctrl_group[a->ctrl], gb = s->objects[b->object]->ctrl_group[b->ctrl];
+            if (a->object == b->object) {
+                /* two groups of one object (self-contact): exact where the object's own
+                 * pattern has their block */
+                const sem_object *o = s->objects[a->object];
+                int lo = ga < gb ? ga : gb, hi = ga < gb ? gb : ga;
+                if (o->gpair_lookup[(size_t)lo * o->n_groups + hi] < 0) return 0;
+                continue;
+            }
+            if (a->object > b->object) continue;
             coupling[i * m + j] = sem_system_find_coupling(s, a->object, ga, b->object, gb);
             if (coupling[i * m + j] < 0) return 0;
         }

@@ -181,6 +181,7 @@ int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_part
     size_t r0 = (size_t)n_parts * (size_t)n_basis;
     return def->solver == SEM_SOLVER_STRUCTURED ||
            (def->solver == SEM_SOLVER_AUTO && !def->advanced.solve_together && !def->advanced.q_space_solvers &&
+            !(def->contact.self > 0 && !def->contact.disabled) && /* contact takes no structured system */
             (shared_fit || (n_ctrl >= 2 * r0 && 3 * r0 <= SEM_MAX_STRUCTURED_COEFFICIENTS)));
 }
 

@@ -771,8 +771,12 @@ static sem_status parse_contact(ctx *c, const cJSON *root, sem_contact_def *def)
     int enabled = 1;
     if ((st = get_bool(c, o, "enabled", w, &enabled)) != SEM_OK) return st;
     def->disabled = !enabled;
-    if ((st = get_bool(c, o, "self", w, &def->self)) != SEM_OK) return st;
-    if (def->self) return fail(c, "contact.self", "self-contact is not implemented yet (use false)");
+    const cJSON *self = cJSON_GetObjectItemCaseSensitive(o, "self");
+    if (self && !cJSON_IsNull(self)) { /* null or absent: the default (on wherever contact is) */
+        int on = 0;
+        if ((st = get_bool(c, o, "self", w, &on)) != SEM_OK) return st;
+        def->self = on ? 1 : -1;
+    }
     static const char *const positive[] = {"stiffness", "thickness", "friction_velocity", NULL};
     double *values[] = {&def->stiffness, &def->thickness, &def->friction_velocity};
     for (int k = 0; positive[k]; ++k) {

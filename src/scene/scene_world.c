@@ -81,12 +81,13 @@ static sem_status prefix_error(sem_error *err, sem_status st, const char *name, 
 }
 
 /* The scene's world settings. Contact: the structured solver takes no contact terms yet
- * (point_terms.h), so a scene where contact can happen (colliders, or two objects or more)
- * keeps the q-space solvers. */
+ * (point_terms.h), so a scene where contact can happen (colliders, two objects or more, or
+ * self-contact asked for) keeps the q-space solvers. */
 static sem_world_def scene_world_def(const sem_scene *scene)
 {
     sem_world_def d = scene->world;
-    if (!d.contact.disabled && (scene->n_colliders > 0 || scene->n_objects >= 2)) d.advanced.q_space_solvers = 1;
+    if (!d.contact.disabled && (scene->n_colliders > 0 || scene->n_objects >= 2 || d.contact.self > 0))
+        d.advanced.q_space_solvers = 1;
     return d;
 }
 

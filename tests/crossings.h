@@ -1,0 +1,19 @@
+/*
+ * crossings.h - do a deformed triangle mesh's surfaces pass through each other? (tests)
+ *
+ * The check of the self-contact scenes (issue 31): every pair of triangles of a frame's
+ * render mesh that intersect, except pairs that touch at rest (they share a corner position
+ * within 1e-9 of the mesh's size at rest: neighbours, and neighbours across the seams of
+ * parts, whose vertices the mesh repeats). Two triangles intersect when an edge of one
+ * passes through the other (a proper crossing of non-coplanar triangles always has one;
+ * coplanar touching is not counted). Sweep and prune along x over the triangles' boxes, so a
+ * frame of a few thousand triangles takes milliseconds.
+ */
+#ifndef SEM_TESTS_CROSSINGS_H
+#define SEM_TESTS_CROSSINGS_H
+
+/* Counts the intersecting pairs of the mesh at positions x (3 per vertex) that do not touch
+ * at rest positions x0; triangles: 3 vertex indices each. -1: out of memory. */
+long count_crossings(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles);
+
+#endif
