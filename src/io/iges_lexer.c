@@ -498,19 +498,27 @@ static int de_field(const iges_line *l, int f, int *out)
     return 1;
 }
 
-/* The directory entry a Parameter line points back to (columns 66-72), or -1. */
-static int p_back_pointer(const iges_reader *r, int line)
+/* Columns 66-72 of Parameter line `line` (from 0), the back pointer to its directory entry,
+ * into *back; 0 when the line is shorter or they hold no integer. */
+static int p_back_field(const iges_reader *r, int line, long *back)
 {
     const iges_line *l = &r->lines[r->sec_first[SEC_P] + line];
-    if (l->len < 72) return -1;
+    if (l->len < 72) return 0;
     char buf[8];
     int n = 0;
     for (int c = 65; c < 72; ++c)
         if (l->text[c] != ' ') buf[n++] = l->text[c];
     buf[n] = '\0';
     char *end;
-    long back = strtol(buf, &end, 10);
-    return n > 0 && *end == '\0' && back > 0 && back < INT32_MAX ? (int)back : -1;
+    *back = strtol(buf, &end, 10);
+    return n > 0 && *end == '\0';
+}
+
+/* The directory entry a Parameter line points back to (columns 66-72), or -1. */
+static int p_back_pointer(const iges_reader *r, int line)
+{
+    long back;
+    return p_back_field(r, line, &back) && back > 0 && back < INT32_MAX ? (int)back : -1;
 }
 
 static sem_status read_directory(iges_reader *r)
@@ -611,21 +619,12 @@ static sem_status read_parameters(iges_reader *r)
         iges_entry *e = &r->entries[i];
         if (e->type == 0) continue;
         const iges_line *first = &r->lines[r->sec_first[SEC_P] + e->pd_pointer - 1];
-        if (first->len >= 72) {
-            /* columns 66-72: back pointer to the directory entry */
-            char buf[8];
-            int n = 0;
-            for (int c = 65; c < 72; ++c)
-                if (first->text[c] != ' ') buf[n++] = first->text[c];
-            buf[n] = '\0';
-            char *end;
-            long back = strtol(buf, &end, 10);
-            if (n > 0 && *end == '\0' && back != iges_de_number(i))
-                return parse_error(r, first->number,
-                                   "parameter line %d belongs to DE %ld, but DE %d (entity %d) "
-                                   "points to it",
-                                   e->pd_pointer, back, iges_de_number(i), e->type);
-        }
+        long back;
+        if (p_back_field(r, e->pd_pointer - 1, &back) && back != iges_de_number(i))
+            return parse_error(r, first->number,
+                               "parameter line %d belongs to DE %ld, but DE %d (entity %d) "
+                               "points to it",
+                               e->pd_pointer, back, iges_de_number(i), e->type);
         char what[64];
         snprintf(what, sizeof what, "entity %d (DE %d)", e->type, iges_de_number(i));
         size_t begin = (size_t)(e->pd_pointer - 1) * PLINE_WIDTH;
