@@ -140,16 +140,19 @@ static void mark_references(iges_reader *r)
          * (referenced entities are not emitted on their own) without a word */
 #define MARK(K)                                                                          \
     do {                                                                                 \
-        if (iges_peek_ptr(r, i, (K), &p)) {                                                   \
+        if (iges_peek_ptr(r, i, (K), &p)) {                                              \
             if (p == i) self = 1;                                                        \
             else r->entries[p].referenced = 1;                                           \
         }                                                                                \
     } while (0)
+        /* parameter COUNT says how many pointers follow, from parameter FIRST, STEP apart */
+#define MARK_LIST(COUNT, FIRST, STEP)                                                    \
+    do {                                                                                 \
+        if (iges_peek_int(r, i, (COUNT), &n))                                            \
+            for (int j = 0; j < n && j < e->n_params; ++j) MARK((FIRST) + (STEP) * j);   \
+    } while (0)
         switch (e->type) {
-        case 102:
-            if (iges_peek_int(r, i, 1, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(2 + j);
-            break;
+        case 102: MARK_LIST(1, 2, 1); break;
         case 108: list[nl++] = 5; break;
         case 118: list[nl++] = 1; list[nl++] = 2; break;
         case 120: list[nl++] = 1; list[nl++] = 2; break;
@@ -169,28 +172,21 @@ static void mark_references(iges_reader *r)
         case 142: list[nl++] = 2; list[nl++] = 3; list[nl++] = 4; break;
         case 143:
             MARK(2);
-            if (iges_peek_int(r, i, 3, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(4 + j);
+            MARK_LIST(3, 4, 1);
             break;
         case 144:
             MARK(1);
             MARK(4);
-            if (iges_peek_int(r, i, 3, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(5 + j);
+            MARK_LIST(3, 5, 1);
             break;
         case 186:
             MARK(1);
-            if (iges_peek_int(r, i, 3, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(4 + 2 * j);
+            MARK_LIST(3, 4, 2);
             break;
-        case 514:
-            if (iges_peek_int(r, i, 1, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(2 + 2 * j);
-            break;
+        case 514: MARK_LIST(1, 2, 2); break;
         case 510:
             MARK(1);
-            if (iges_peek_int(r, i, 2, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(4 + j);
+            MARK_LIST(2, 4, 1);
             break;
         case 508:
             if (!iges_peek_int(r, i, 1, &n)) break;
@@ -202,10 +198,7 @@ static void mark_references(iges_reader *r)
                 k += 5 + 2 * kk;
             }
             break;
-        case 504:
-            if (iges_peek_int(r, i, 1, &n))
-                for (int j = 0; j < n && j < e->n_params; ++j) MARK(2 + 5 * j);
-            break;
+        case 504: MARK_LIST(1, 2, 5); break;
         case 308:
             if (iges_peek_int(r, i, 3, &n))
                 for (int j = 0; j < n && j < e->n_params; ++j)
@@ -222,6 +215,7 @@ static void mark_references(iges_reader *r)
         default: break;
         }
         for (int j = 0; j < nl; ++j) MARK(list[j]);
+#undef MARK_LIST
 #undef MARK
         if (self) {
             r->entries[i].self_ref = 1;
