@@ -16,6 +16,16 @@
 
 #include "io/iges_internal.h"
 
+/* Moves every curve of `from` to the end of `to`, leaving `from` empty. Best effort, for
+ * hints: a curve that cannot be added is freed. */
+static void move_curves(iges_reader *r, curve_list *to, curve_list *from)
+{
+    for (int j = 0; j < from->n; ++j)
+        if (iges_list_push(r, to, &from->c[j]) != SEM_OK) sem_curve_free(&from->c[j]);
+    free(from->c);
+    memset(from, 0, sizeof *from);
+}
+
 /* The 142 at parameter k of owner, checked. */
 static sem_status curve_on_surface_entity(iges_reader *r, int owner, int k, int *p)
 {
@@ -80,9 +90,7 @@ static void trimmed_hint(iges_reader *r, int idx, int n1, int n2, const double *
             iges_list_free(&c); /* a composite that failed part-way keeps the members it read */
             continue;
         }
-        for (int j = 0; j < c.n; ++j)
-            if (iges_list_push(r, hint, &c.c[j]) != SEM_OK) sem_curve_free(&c.c[j]);
-        free(c.c);
+        move_curves(r, hint, &c);
     }
 }
 
@@ -178,10 +186,7 @@ static sem_status boundary_loop(iges_reader *r, int idx, const double *m, int de
     }
     if (st == SEM_OK && !part) {
         /* only the curves are wanted (a hint for the surface) */
-        for (int i = 0; i < model_curves.n; ++i)
-            if (iges_list_push(r, l, &model_curves.c[i]) != SEM_OK)
-                sem_curve_free(&model_curves.c[i]);
-        free(model_curves.c);
+        move_curves(r, l, &model_curves);
         return SEM_OK;
     }
     if (st == SEM_OK) st = iges_project_model_space_loop(r, idx, part, &model_curves, l, border);
