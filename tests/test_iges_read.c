@@ -534,16 +534,16 @@ static void test_model_space_trims(void)
  * have their areas (the top one with a hole of radius 0.5) and the box its extent. Before,
  * each face was a 2 x 2 square at the display point and every loop was left out ("16 away
  * from its surface"). Two 143s list a hole before the outer boundary (I-DEAS): the outer loop
- * is the one that holds the others. */
+ * is the one that holds the others; a third lists its outer boundary first. */
 static void test_unbounded_planes(void)
 {
     sem_model *m = load_data("iges_unbounded_planes.igs");
     if (!m) return;
-    CHECK(m->n_parts == 8, "parts %d", m->n_parts);
+    CHECK(m->n_parts == 9, "parts %d", m->n_parts);
     CHECK(m->n_warnings == 0, "warnings %d: %s", m->n_warnings, m->n_warnings ? m->warnings[0] : "");
-    if (m->n_parts == 8) {
-        const double expected[8] = {12, 12 - M_PI / 4, 6, 6, 8, 8, 18 - M_PI, 12 - M_PI / 4};
-        for (int i = 0; i < 8; ++i) {
+    if (m->n_parts == 9) {
+        const double expected[9] = {12, 12 - M_PI / 4, 6, 6, 8, 8, 18 - M_PI, 12 - M_PI / 4, 18 - M_PI};
+        for (int i = 0; i < 9; ++i) {
             sem_part_measure_result r;
             int trimmed = i == 1 || i >= 6;
             CHECK(sem_part_measure(&m->parts[i], &r, NULL) == SEM_OK, "measure part %d", i);
@@ -555,9 +555,12 @@ static void test_unbounded_planes(void)
          * that is its plane's border leaves no outer loop, the circle a hole */
         CHECK(m->parts[6].has_outer && m->parts[6].n_holes == 1, "triangle around a hole");
         CHECK(!m->parts[7].has_outer && m->parts[7].n_holes == 1, "border around a hole");
+        /* the same triangle with its outer boundary first: the plane is sized by both
+         * boundaries (it was sized by the last one read, the hole, before) */
+        CHECK(m->parts[8].has_outer && m->parts[8].n_holes == 1, "triangle (outer first) around a hole");
         sem_part_measure_result total;
         CHECK(sem_model_measure(m, NULL, &total, NULL) == SEM_OK, "measure");
-        const double hi[3] = {6, 6, 7};
+        const double hi[3] = {6, 6, 9};
         for (int d = 0; d < 3; ++d) {
             CHECK(fabs(total.bbox_min[d]) < 1e-12, "bbox min %d: %g", d, total.bbox_min[d]);
             CHECK(fabs(total.bbox_max[d] - hi[d]) < 1e-12, "bbox max %d: %g", d, total.bbox_max[d]);

@@ -222,8 +222,11 @@ sem_status iges_emit_bounded(iges_reader *r, int idx, const double *parent, int 
     memset(&hint, 0, sizeof hint);
     for (int i = 0; st == SEM_OK && iges_needs_hint(r, surf) && i < n; ++i) {
         int b, border;
+        curve_list one; /* boundary_loop starts its list afresh: one boundary at a time */
+        memset(&one, 0, sizeof one);
         if (iges_param_ptr(r, idx, 4 + i, 0, &b) == SEM_OK)
-            (void)boundary_loop(r, b, m, depth + 1, NULL, 1, &hint, &border);
+            (void)boundary_loop(r, b, m, depth + 1, NULL, 1, &one, &border);
+        move_curves(r, &hint, &one);
     }
     sem_part part;
     memset(&part, 0, sizeof part);

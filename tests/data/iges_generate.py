@@ -541,7 +541,8 @@ def file_unbounded_planes():
     (BPTR = 0, PREF 2). The top face has a hole of radius 0.5 around (2, 1.5) (a 100 arc
     at ZT = 2). The display size must not bound the plane: areas 12, 12 - pi / 4, 6, 6,
     8, 8 (the corpus files occt_cone_catia and occt_cylinder_catia lost their caps).
-    Then two 143 bounded surfaces whose hole comes first (below)."""
+    Then two 143 bounded surfaces whose hole comes first, and one whose outer boundary comes
+    first (below)."""
     sub = "00010000"
     E = []
 
@@ -574,9 +575,12 @@ def file_unbounded_planes():
     # outer boundary, as I-DEAS does (corpus occt_ideas_simple1_143): a triangle (0,0)-(6,0)-
     # (0,6) at z = 5 around a hole of radius 1 at (1.5, 1.5): 18 - pi; the rectangle
     # [0,4] x [0,3] at z = 7 (the fitted plane's own border) around a hole of radius 0.5 at
-    # (2, 1.5): 12 - pi / 4
-    for z, corners, centre, radius in ((5.0, [(0, 0), (6, 0), (0, 6)], (1.5, 1.5), 1.0),
-                                       (7.0, [(0, 0), (4, 0), (4, 3), (0, 3)], (2.0, 1.5), 0.5)):
+    # (2, 1.5): 12 - pi / 4; and the triangle again at z = 9 with its outer boundary first
+    # (the usual order: the plane must be sized by all boundaries, not by the last one read)
+    for z, corners, centre, radius, outer_first in (
+            (5.0, [(0, 0), (6, 0), (0, 6)], (1.5, 1.5), 1.0, False),
+            (7.0, [(0, 0), (4, 0), (4, 3), (0, 3)], (2.0, 1.5), 0.5, False),
+            (9.0, [(0, 0), (6, 0), (0, 6)], (1.5, 1.5), 1.0, True)):
         t143 = add(None)
         plane = add(Ent(108, ["0.0", "0.0", "1.0", r(z), "0", "-20.0", "30.0", r(z), "1.0"],
                         status=sub))
@@ -590,7 +594,8 @@ def file_unbounded_planes():
         for ln in lines:
             outer += [de(ln), "1", "0"]
         o141 = add(Ent(141, outer, status=sub))
-        E[t143] = Ent(143, ["0", de(plane), "2", de(h141), de(o141)])
+        order = [de(o141), de(h141)] if outer_first else [de(h141), de(o141)]
+        E[t143] = Ent(143, ["0", de(plane), "2"] + order)
     save("iges_unbounded_planes.igs", build(E, unit_flag=2, unit_name="MM"))
 
 
