@@ -51,42 +51,22 @@
  *   (+ when the +normal ray is even); the sign of the sum decides, ties keep +1. Several
  *   jittered pairs from several places outvote accidents: a ray escaping through a gap or
  *   an open end (the rocket has no bottom) or grazing an edge.
- * - Generalized winding number (Jacobson et al. 2013): the sum over the orientation-
- *   corrected triangles of their signed solid angles seen from X (Van Oosterom & Strackee
- *   1983: tan(Omega/2) = det[a b c] / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|)),
- *   divided by 4 pi. sem_raycast_winding_number_exact sums every triangle;
- *   sem_raycast_winding_number uses Barill et al.'s (2018) tree with a second-order
- *   far field, within 5e-3 of the exact value (see below). Both re-entrant.
  * - Closest parts: exact double-precision point-triangle distances (Ericson, Real-Time
  *   Collision Detection, 5.1.5), minimum per part within the radius. The public query walks
  *   a small box tree per part (built on first use) with a radius that shrinks to the best
  *   distance so far; the component search at scene build uses one Embree rtcPointQuery
- *   (its radius is tiny). The winding-number tree is built with the scene (after the
- *   orientation fix), since the quadrature queries it for every inside segment.
+ *   (its radius is tiny).
  * - Orientation votes stop as soon as the votes not cast yet cannot change the sign.
  */
-#include "raycast.h"
+#include "raycast_scene.h"
 #include "util/union_find.h"
 
-#include <embree3/rtcore.h>
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "sem/nurbs.h"
 #include "sem/tessellate.h"
-
-/* The tessellation as this file uses it: vertices (3 doubles each) and triangles (3
- * vertex indices each) with the part of each triangle. */
-typedef struct raw_mesh {
-    int n_vertices;
-    double *vertices;
-    double *uv; /* 2 per vertex: the part's (u,v) */
-    int n_triangles;
-    int *triangles;
-    int *triangle_part;
-} raw_mesh;
 
 static void raw_mesh_free(raw_mesh *m)
 {
@@ -127,54 +107,6 @@ static sem_status tessellate(const sem_model *model, int resolution, raw_mesh *o
         return sem_error_set(err, SEM_ERR_INVALID, "raycast: incomplete tessellation");
     }
     return SEM_OK;
-}
-
-struct sem_raycast_scene {
-    RTCDevice device;
-    RTCScene scene;
-    int n_parts;
-    int *part_sign;       /* n_parts, +1/-1 */
-    int *part_component;  /* n_parts: smallest part index of the touching parts' component */
-    int *part_tri_offset; /* n_parts + 1: part i owns triangles [off[i], off[i+1]) */
-    int n_triangles;
-    double *tri;          /* 9 per triangle: v0, v1, v2 */
-    double *tri_normal;   /* 3 per triangle: unit (v1-v0)x(v2-v0), before the fix */
-    double *tri_area;     /* per triangle */
-    double *tri_uv;       /* 6 per triangle: (u,v) of v0, v1, v2 */
-    /* fast winding number tree (see sem_raycast_winding_number) */
-    struct winding_node *winding_nodes;
-    int n_winding_nodes;
-    int *winding_order;       /* build scratch: triangle indices in tree order */
-    signed char *winding_sign; /* build scratch: part_sign of each triangle */
-    struct winding_tri *winding_tris; /* the triangles in tree order, orientation-corrected */
-    int winding_failed;       /* out of memory while building it: exact sums instead */
-    /* per-part bounding-volume trees for closest-point queries (built on first use) */
-    struct part_node *part_nodes;
-    int *part_root;           /* n_parts: root node of each part, -1 when empty */
-    int *part_tri_order;      /* triangles in tree order (global indices) */
-    struct part_node *top_nodes; /* a tree over the parts' root boxes (leaves: top_order) */
-    int *top_order;           /* part indices in that tree's order */
-    int top_root;             /* -1 when no part has triangles */
-    int parts_built, parts_failed;
-    sem_surface *surfaces; /* copies of the parts' surfaces, for exact hit refinement */
-    double lo[3], hi[3];
-    double scale;         /* bounding-box diagonal (> 0) */
-    double merge_eps;     /* hits of one part closer than this are one crossing */
-};
-
-/* ---- small vector helpers ---- */
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void sub3(const double *a, const double *b, double *r)
-{
-    r[0] = a[0] - b[0];
-    r[1] = a[1] - b[1];
-    r[2] = a[2] - b[2];
-}
-static void cross3(const double *a, const double *b, double *r)
-{
-    r[0] = a[1] * b[2] - a[2] * b[1];
-    r[1] = a[2] * b[0] - a[0] * b[2];
-    r[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 /* ---- all-hits collection ---- */
@@ -412,7 +344,7 @@ static int merge_hits(const sem_raycast_scene *s, const double *dir, sem_ray_hit
 
 /* All hits in (t_near, t_far), merged and sorted. Returns the count (writes at most
  * max_hits), or -1 when out of memory. */
-static int all_hits(const sem_raycast_scene *s, const double *origin, const double *dir,
+int sem_raycast_all_hits(const sem_raycast_scene *s, const double *origin, const double *dir,
                     double t_near, double t_far, sem_ray_hit *out, int max_hits, int use_sign)
 {
     hit_collector c;
@@ -462,7 +394,7 @@ int sem_raycast_all(const sem_raycast_scene *scene, const double origin[3], cons
                     double t_near, double t_far, sem_ray_hit *hits, int max_hits)
 {
     if (!scene || !origin || !dir || scene->n_triangles == 0) return 0;
-    int n = all_hits(scene, origin, dir, t_near, t_far, hits, max_hits, 1);
+    int n = sem_raycast_all_hits(scene, origin, dir, t_near, t_far, hits, max_hits, 1);
     return n < 0 ? 0 : n;
 }
 
@@ -590,7 +522,7 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 
 /* Closest parts by one Embree point query over the whole scene (cost: every triangle within
  * the radius); used for the small radii of the component search. */
-static int closest_parts_embree(const sem_raycast_scene *scene, const double X[3], double radius,
+int sem_raycast_closest_parts_embree(const sem_raycast_scene *scene, const double X[3], double radius,
                                 int *out_parts, double *out_dist, double *out_points)
 {
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
@@ -662,7 +594,7 @@ typedef struct part_node {
 /* Reorders the triangle indices o[0..count) so that o[count / 2] has the median centroid
  * along axis, smaller ones before it and larger ones after (quickselect): the split of both
  * bounding-volume trees below. */
-static void select_median(int *o, int count, const double *centroid, int axis)
+void sem_raycast_select_median(int *o, int count, const double *centroid, int axis)
 {
     int half = count / 2;
     int l = 0, r = count - 1;
@@ -721,7 +653,7 @@ static int build_box_node(part_node *nodes, int *order, const double *box, const
     for (int d = 1; d < 3; d++)
         if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
     int half = count / 2;
-    select_median(o, count, centre, axis);
+    sem_raycast_select_median(o, count, centre, axis);
     int left = build_box_node(nodes, order, box, centre, n_nodes, first, half);
     int right = build_box_node(nodes, order, box, centre, n_nodes, first + half, count - half);
     nodes[id].left = left;
@@ -729,7 +661,7 @@ static int build_box_node(part_node *nodes, int *order, const double *box, const
     return id;
 }
 
-static void free_part_trees(sem_raycast_scene *s)
+void sem_raycast_free_part_trees(sem_raycast_scene *s)
 {
     free(s->part_nodes);
     free(s->part_tri_order);
@@ -756,7 +688,7 @@ static int build_part_trees(sem_raycast_scene *s)
         !centre) {
         free(box);
         free(centre);
-        free_part_trees(s);
+        sem_raycast_free_part_trees(s);
         return 0;
     }
     for (int t = 0; t < n; t++) {
@@ -893,7 +825,7 @@ int sem_raycast_closest_parts_except(const sem_raycast_scene *scene, const doubl
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
         return 0;
     if (!ensure_part_trees(scene)) {
-        int found = closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points), n = 0;
+        int found = sem_raycast_closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points), n = 0;
         for (int k = 0; k < found; ++k) {
             if (out_parts[k] == exclude) continue;
             out_parts[n] = out_parts[k];
@@ -950,278 +882,10 @@ int sem_raycast_closest_parts_except(const sem_raycast_scene *scene, const doubl
 }
 
 
-/* ---- generalized winding number ---- */
-
-/* Signed solid angle of triangle v (9 doubles) seen from X (Van Oosterom-Strackee). */
-static double solid_angle(const double *v, const double *X)
-{
-    double a[3], b[3], c[3], bc[3];
-    sub3(v, X, a);
-    sub3(v + 3, X, b);
-    sub3(v + 6, X, c);
-    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), lc = sqrt(dot3(c, c));
-    cross3(b, c, bc);
-    double det = dot3(a, bc);
-    double den = la * lb * lc + dot3(a, b) * lc + dot3(b, c) * la + dot3(c, a) * lb;
-    return 2.0 * atan2(det, den);
-}
-
-double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const double X[3])
-{
-    if (!scene || !X) return 0.0;
-    double total = 0.0;
-    for (int part = 0; part < scene->n_parts; part++) {
-        double sum = 0.0;
-        for (int t = scene->part_tri_offset[part]; t < scene->part_tri_offset[part + 1]; t++)
-            sum += solid_angle(scene->tri + 9 * (size_t)t, X);
-        total += scene->part_sign[part] * sum;
-    }
-    return total / (4.0 * M_PI);
-}
-
-/* Fast winding number (Barill et al. 2018, second order): a BVH over the orientation-
- * corrected triangles; a node seen from farther than beta times its radius contributes
- * the Taylor expansion of its solid angle about its area-weighted centroid p to second
- * order: N . r / |r|^3 + tr(C) / |r|^3 - 3 r . C r / |r|^5 with r = p - X, N the sum of
- * area-weighted normals and C = sum of area n (c - p)^T over its triangles (centroids c;
- * exact, since a triangle's first moment about its centroid is zero). Nearer nodes
- * recurse, leaves are exact. On a curved piece seen from its centre of curvature the
- * second-order term is of the same size as the third-order one left out (both (r/d)^2:
- * symmetry cancels the r/d part), so the accurate query keeps a conservative beta = 8:
- * the measured difference to the exact sum stays below 5e-3 (test_raycast, including the
- * sphere's centre, where beta = 6 gave 6e-3), and the castle's quadrature drops from
- * 0.42 s (exact) to a few ms. */
-#define WINDING_BETA 8.0
-/* For yes/no decisions with a margin (quadrature.c decides with this one unless it lies
- * within 0.15 of the threshold), a far field from 1.5 radii: worst error 0.095 at 1500
- * random points of each of the tire, castle, rocket, grumpy, mug, chicken and starship
- * (the first-order far field from 2 radii, used before, reached 0.156 on the tire), at
- * about half the cost. */
-#define WINDING_BETA_COARSE 1.5
-/* The middle level of sem_raycast_winding_above's cascade (worst error 0.013 measured). */
-#define WINDING_BETA_MEDIUM 4.0
-#define WINDING_LEAF 8
-
-/* A leaf triangle as the winding number reads it: vertices in corrected order (v1 and v2
- * swapped when the part's sign is -1, which negates the solid angle), the area-weighted
- * corrected normal and centroid of its own dipole, and its squared radius about the
- * centroid. A leaf triangle seen from beyond beta radii is summed as a dipole too, by the
- * same rule as a node: near a thin solid most of a leaf's triangles are far even when the
- * leaf is not, and the dipole costs one square root against the solid angle's three and
- * an atan2. Contiguous, so a leaf is one cache-friendly run. */
-typedef struct winding_tri {
-    double v[9];
-    double c[3];
-    double an[3];
-    double r2;
-} winding_tri;
-
-typedef struct winding_node {
-    double p[3];       /* area-weighted centroid */
-    double N[3];       /* sum of area x corrected unit normal */
-    double C[9];       /* sum of area x n (c - p)^T, row-major: the second-order term */
-    double radius;     /* max distance from p to the node's vertices */
-    int left, right;   /* children, -1 for a leaf */
-    int first, count;  /* leaf: range in winding_order */
-} winding_node;
-
-static int build_winding_node(sem_raycast_scene *s, double *centroid, int first, int count)
-{
-    int id = s->n_winding_nodes++;
-    winding_node *node = &s->winding_nodes[id];
-    double area = 0, p[3] = {0, 0, 0}, N[3] = {0, 0, 0}, lo[3], hi[3];
-    for (int d = 0; d < 3; d++) {
-        lo[d] = INFINITY;
-        hi[d] = -INFINITY;
-    }
-    for (int k = first; k < first + count; k++) {
-        int t = s->winding_order[k];
-        double at = s->tri_area[t], sg = s->winding_sign[t];
-        for (int d = 0; d < 3; d++) {
-            p[d] += at * centroid[3 * (size_t)t + d];
-            N[d] += sg * at * s->tri_normal[3 * (size_t)t + d];
-            double c = centroid[3 * (size_t)t + d];
-            if (c < lo[d]) lo[d] = c;
-            if (c > hi[d]) hi[d] = c;
-        }
-        area += at;
-    }
-    for (int d = 0; d < 3; d++) p[d] /= area;
-    double C[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    for (int k = first; k < first + count; k++) {
-        int t = s->winding_order[k];
-        double at = s->tri_area[t], sg = s->winding_sign[t];
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                C[3 * i + j] += sg * at * s->tri_normal[3 * (size_t)t + i] *
-                                (centroid[3 * (size_t)t + j] - p[j]);
-    }
-    double r2 = 0;
-    for (int k = first; k < first + count; k++) {
-        const double *v = s->tri + 9 * (size_t)s->winding_order[k];
-        for (int c = 0; c < 3; c++) {
-            double w[3];
-            sub3(v + 3 * c, p, w);
-            double q = dot3(w, w);
-            if (q > r2) r2 = q;
-        }
-    }
-    memcpy(node->p, p, sizeof p);
-    memcpy(node->N, N, sizeof N);
-    memcpy(node->C, C, sizeof C);
-    node->radius = sqrt(r2);
-    node->first = first;
-    node->count = count;
-    node->left = node->right = -1;
-    if (count <= WINDING_LEAF) return id;
-    /* split at the median of the longest centroid extent (nth by partial sort) */
-    int axis = 0;
-    for (int d = 1; d < 3; d++)
-        if (hi[d] - lo[d] > hi[axis] - lo[axis]) axis = d;
-    int half = count / 2;
-    int *o = s->winding_order + first;
-    select_median(o, count, centroid, axis);
-    int left = build_winding_node(s, centroid, first, half);
-    int right = build_winding_node(s, centroid, first + half, count - half);
-    s->winding_nodes[id].left = left;
-    s->winding_nodes[id].right = right;
-    return id;
-}
-
-/* Builds the tree once part_sign is known. Returns 0 when out of memory. */
-static int build_winding_tree(sem_raycast_scene *s)
-{
-    int n = s->n_triangles;
-    s->winding_order = malloc((size_t)n * sizeof *s->winding_order);
-    s->winding_sign = malloc((size_t)n * sizeof *s->winding_sign);
-    s->winding_nodes = malloc((size_t)(2 * n) * sizeof *s->winding_nodes);
-    double *centroid = malloc((size_t)n * 3 * sizeof *centroid);
-    if (!s->winding_order || !s->winding_sign || !s->winding_nodes || !centroid) {
-        free(centroid);
-        free(s->winding_order);
-        free(s->winding_sign);
-        free(s->winding_nodes);
-        s->winding_order = NULL;
-        s->winding_sign = NULL;
-        s->winding_nodes = NULL;
-        return 0;
-    }
-    for (int p = 0; p < s->n_parts; p++)
-        for (int t = s->part_tri_offset[p]; t < s->part_tri_offset[p + 1]; t++)
-            s->winding_sign[t] = (signed char)s->part_sign[p];
-    for (int t = 0; t < n; t++) {
-        s->winding_order[t] = t;
-        const double *v = s->tri + 9 * (size_t)t;
-        for (int d = 0; d < 3; d++) centroid[3 * (size_t)t + d] = (v[d] + v[3 + d] + v[6 + d]) / 3;
-    }
-    s->n_winding_nodes = 0;
-    build_winding_node(s, centroid, 0, n);
-    s->winding_tris = malloc((size_t)(n > 0 ? n : 1) * sizeof *s->winding_tris);
-    if (!s->winding_tris) {
-        free(centroid);
-        return 0;
-    }
-    for (int k = 0; k < n; k++) {
-        int t = s->winding_order[k];
-        winding_tri *wt = &s->winding_tris[k];
-        const double *v = s->tri + 9 * (size_t)t;
-        int sg = s->winding_sign[t];
-        memcpy(wt->v, v, 3 * sizeof *v);
-        memcpy(wt->v + 3, sg > 0 ? v + 3 : v + 6, 3 * sizeof *v);
-        memcpy(wt->v + 6, sg > 0 ? v + 6 : v + 3, 3 * sizeof *v);
-        double r2 = 0;
-        for (int d = 0; d < 3; d++) {
-            wt->c[d] = centroid[3 * (size_t)t + d];
-            wt->an[d] = sg * s->tri_area[t] * s->tri_normal[3 * (size_t)t + d];
-        }
-        for (int c = 0; c < 3; c++) {
-            double w[3];
-            sub3(v + 3 * c, wt->c, w);
-            double q = dot3(w, w);
-            if (q > r2) r2 = q;
-        }
-        wt->r2 = r2;
-    }
-    free(centroid);
-    /* queries read winding_tris only */
-    free(s->winding_order);
-    free(s->winding_sign);
-    s->winding_order = NULL;
-    s->winding_sign = NULL;
-    return 1;
-}
-
-static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta);
-
-double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X[3])
-{
-    return winding_number_beta(scene, X, WINDING_BETA);
-}
-
-double sem_raycast_winding_number_coarse(const sem_raycast_scene *scene, const double X[3])
-{
-    return winding_number_beta(scene, X, WINDING_BETA_COARSE);
-}
-
-/* A cascade of far fields, each trusted when it is farther from the threshold than about
- * three times its worst error measured on the shared models (0.095 at 1.5 radii, 0.013
- * at 4 radii, 2.4e-3 at 8 radii): most points are decided by the cheapest, and only
- * values close to the threshold pay for the accurate sum. */
-int sem_raycast_winding_above(const sem_raycast_scene *scene, const double X[3], double threshold)
-{
-    double w = winding_number_beta(scene, X, WINDING_BETA_COARSE);
-    if (fabs(w - threshold) > 0.15) return w > threshold;
-    w = winding_number_beta(scene, X, WINDING_BETA_MEDIUM);
-    if (fabs(w - threshold) > 0.04) return w > threshold;
-    return winding_number_beta(scene, X, WINDING_BETA) > threshold;
-}
-
-static double winding_number_beta(const sem_raycast_scene *scene, const double X[3], double beta)
-{
-    if (!scene || !X) return 0.0;
-    if (scene->winding_failed || !scene->winding_nodes)
-        return sem_raycast_winding_number_exact(scene, X);
-    int stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    double total = 0.0;
-    while (top > 0) {
-        const winding_node *node = &scene->winding_nodes[stack[--top]];
-        double w[3];
-        sub3(node->p, X, w);
-        double d2 = dot3(w, w);
-        if (d2 > beta * beta * node->radius * node->radius) {
-            /* Taylor expansion of (x - X)/|x - X|^3 about p to first order in x - p */
-            double id = 1.0 / sqrt(d2), id3 = id / d2, id5 = id3 / d2;
-            const double *C = node->C;
-            double Cw[3] = {C[0] * w[0] + C[1] * w[1] + C[2] * w[2],
-                            C[3] * w[0] + C[4] * w[1] + C[5] * w[2],
-                            C[6] * w[0] + C[7] * w[1] + C[8] * w[2]};
-            total += dot3(node->N, w) * id3 + (C[0] + C[4] + C[8]) * id3 - 3.0 * dot3(w, Cw) * id5;
-        } else if (node->left < 0 || top + 2 > 128) {
-            const winding_tri *wt = scene->winding_tris + node->first;
-            for (int k = 0; k < node->count; k++, wt++) {
-                double u[3];
-                sub3(wt->c, X, u);
-                double e2 = dot3(u, u);
-                if (e2 > beta * beta * wt->r2)
-                    total += dot3(wt->an, u) / (e2 * sqrt(e2));
-                else
-                    total += solid_angle(wt->v, X);
-            }
-        } else {
-            stack[top++] = node->right;
-            stack[top++] = node->left;
-        }
-    }
-    return total / (4.0 * M_PI);
-}
-
 /* ---- orientation fix ---- */
 
 #define SIGN_SAMPLES 9
 #define SIGN_RAYS 5
-#define COMPONENT_SAMPLES 48
 
 /* Crossings along a ray: all of them and those of parts in component `self`. Returns 0
  * when out of memory. */
@@ -1231,11 +895,11 @@ static int count_crossings(const sem_raycast_scene *s, const int *component, int
 {
     sem_ray_hit local[128];
     sem_ray_hit *hits = local;
-    int n = all_hits(s, origin, dir, t_near, INFINITY, hits, 128, 0);
+    int n = sem_raycast_all_hits(s, origin, dir, t_near, INFINITY, hits, 128, 0);
     if (n > 128) {
         hits = malloc((size_t)n * sizeof *hits);
         if (!hits) return 0;
-        int m = all_hits(s, origin, dir, t_near, INFINITY, hits, n, 0);
+        int m = sem_raycast_all_hits(s, origin, dir, t_near, INFINITY, hits, n, 0);
         if (m < n) n = m;
     }
     if (n < 0) return 0;
@@ -1249,7 +913,7 @@ static int count_crossings(const sem_raycast_scene *s, const int *component, int
 }
 
 /* Estimates part_sign[part] by ray parity votes (see the file comment). */
-static int estimate_part_sign(const sem_raycast_scene *s, const int *component, int part)
+int sem_raycast_estimate_part_sign(const sem_raycast_scene *s, const int *component, int part)
 {
     int t0 = s->part_tri_offset[part], t1 = s->part_tri_offset[part + 1];
     int n = t1 - t0;
@@ -1319,7 +983,7 @@ static int estimate_part_sign(const sem_raycast_scene *s, const int *component, 
 /* Boundary vertices of each part (vertices of edges used by one triangle only), up to
  * COMPONENT_SAMPLES per part spread along the list: 3 doubles each into samples
  * (n_parts * COMPONENT_SAMPLES * 3), counts into n_samples. Returns 0 when out of memory. */
-static int boundary_samples(const raw_mesh *mesh, int n_parts, double *samples, int *n_samples)
+int sem_raycast_boundary_samples(const raw_mesh *mesh, int n_parts, double *samples, int *n_samples)
 {
     for (int p = 0; p < n_parts; p++) n_samples[p] = 0;
     size_t n_edges = 3 * (size_t)mesh->n_triangles;
@@ -1412,7 +1076,7 @@ static int boundary_samples(const raw_mesh *mesh, int n_parts, double *samples, 
 /* Components of parts that touch: a boundary sample of one part within tol of another
  * part joins them (a box's 6 patches form one component; a nested or embedded solid whose
  * boundary does not touch the outer one is its own component). */
-static int part_components(const sem_raycast_scene *s, const double *samples,
+int sem_raycast_part_components(const sem_raycast_scene *s, const double *samples,
                            const int *n_samples, int *component)
 {
     int n_parts = s->n_parts;
@@ -1430,7 +1094,7 @@ static int part_components(const sem_raycast_scene *s, const double *samples,
     for (int p = 0; p < n_parts; p++)
         for (int k = 0; k < n_samples[p]; k++) {
             const double *X = samples + 3 * ((size_t)p * COMPONENT_SAMPLES + (size_t)k);
-            int n = closest_parts_embree(s, X, tol, found, dist, NULL);
+            int n = sem_raycast_closest_parts_embree(s, X, tol, found, dist, NULL);
             for (int i = 0; i < n; i++) {
                 sem_uf_unite(parent, p, found[i]);
             }
@@ -1570,7 +1234,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     (void)total;
     double *bsamples = malloc((size_t)n_parts * COMPONENT_SAMPLES * 3 * sizeof *bsamples);
     int *n_bsamples = malloc((size_t)n_parts * sizeof *n_bsamples);
-    if (!bsamples || !n_bsamples || !boundary_samples(mesh, n_parts, bsamples, n_bsamples)) {
+    if (!bsamples || !n_bsamples || !sem_raycast_boundary_samples(mesh, n_parts, bsamples, n_bsamples)) {
         free(bsamples);
         free(n_bsamples);
         free(new_offset);
@@ -1646,7 +1310,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     /* orientation fix: votes read only the geometry, each part writes its own entry */
     int *sign = malloc((size_t)n_parts * sizeof *sign);
     int *component = malloc((size_t)n_parts * sizeof *component);
-    if (!sign || !component || !part_components(s, bsamples, n_bsamples, component)) {
+    if (!sign || !component || !sem_raycast_part_components(s, bsamples, n_bsamples, component)) {
         free(sign);
         free(component);
         free(bsamples);
@@ -1657,14 +1321,14 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     free(bsamples);
     free(n_bsamples);
 #pragma omp parallel for schedule(dynamic, 1)
-    for (int p = 0; p < n_parts; p++) sign[p] = estimate_part_sign(s, component, p);
+    for (int p = 0; p < n_parts; p++) sign[p] = sem_raycast_estimate_part_sign(s, component, p);
     memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
     free(sign);
     s->part_component = component;
     /* the winding-number tree depends on the corrected signs; the quadrature queries it for
      * every inside segment, so it is part of preparing the scene (out of memory: the
      * queries fall back to exact sums) */
-    s->winding_failed = !build_winding_tree(s);
+    s->winding_failed = !sem_raycast_build_winding_tree(s);
     *out = s;
     return SEM_OK;
 }
@@ -1685,7 +1349,7 @@ void sem_raycast_scene_destroy(sem_raycast_scene *scene)
     free(scene->winding_order);
     free(scene->winding_sign);
     free(scene->winding_tris);
-    free_part_trees(scene);
+    sem_raycast_free_part_trees(scene);
     if (scene->surfaces)
         for (int p = 0; p < scene->n_parts; p++) sem_surface_free(&scene->surfaces[p]);
     free(scene->surfaces);
