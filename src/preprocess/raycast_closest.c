@@ -104,8 +104,9 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 
 /* Closest parts by one Embree point query over the whole scene (cost: every triangle within
  * the radius); used for the small radii of the component search. */
-int sem_raycast_closest_parts_embree(const sem_raycast_scene *scene, const double X[3], double radius,
-                                int *out_parts, double *out_dist, double *out_points)
+int sem_raycast_closest_parts_embree(const sem_raycast_scene *scene, const double X[3],
+                                     double radius, int *out_parts, double *out_dist,
+                                     double *out_points)
 {
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
         return 0;
@@ -407,7 +408,9 @@ int sem_raycast_closest_parts_except(const sem_raycast_scene *scene, const doubl
     if (!scene || !X || !out_parts || !out_dist || scene->n_triangles == 0 || !(radius >= 0))
         return 0;
     if (!ensure_part_trees(scene)) {
-        int found = sem_raycast_closest_parts_embree(scene, X, radius, out_parts, out_dist, out_points), n = 0;
+        int found = sem_raycast_closest_parts_embree(scene, X, radius, out_parts, out_dist,
+                                                     out_points);
+        int n = 0;
         for (int k = 0; k < found; ++k) {
             if (out_parts[k] == exclude) continue;
             out_parts[n] = out_parts[k];

@@ -57,7 +57,10 @@ struct sem_raycast_scene {
 };
 
 /* ---- small vector helpers ---- */
-static inline double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 static inline void sub3(const double *a, const double *b, double *r)
 {
     r[0] = a[0] - b[0];
@@ -82,8 +85,9 @@ int sem_raycast_all_hits(const sem_raycast_scene *s, const double *origin, const
 /* raycast_closest.c: closest parts by one Embree point query over the whole scene (for the
  * small radii of the component search); the median split of the box trees (also the winding
  * tree's); freeing the per-part trees. */
-int sem_raycast_closest_parts_embree(const sem_raycast_scene *scene, const double X[3], double radius,
-                                     int *out_parts, double *out_dist, double *out_points);
+int sem_raycast_closest_parts_embree(const sem_raycast_scene *scene, const double X[3],
+                                     double radius, int *out_parts, double *out_dist,
+                                     double *out_points);
 void sem_raycast_select_median(int *o, int count, const double *centroid, int axis);
 void sem_raycast_free_part_trees(sem_raycast_scene *s);
 
@@ -94,7 +98,8 @@ int sem_raycast_build_winding_tree(sem_raycast_scene *s);
 /* part_orientation.c: the boundary samples of each part (COMPONENT_SAMPLES at most, 3
  * doubles each), the components of touching parts, and a part's sign by ray parity votes.
  * The first two return 0 when out of memory. */
-int sem_raycast_boundary_samples(const raw_mesh *mesh, int n_parts, double *samples, int *n_samples);
+int sem_raycast_boundary_samples(const raw_mesh *mesh, int n_parts, double *samples,
+                                 int *n_samples);
 int sem_raycast_part_components(const sem_raycast_scene *s, const double *samples,
                                 const int *n_samples, int *component);
 int sem_raycast_estimate_part_sign(const sem_raycast_scene *s, const int *component, int part);
