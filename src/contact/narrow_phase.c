@@ -5,7 +5,7 @@
 
 #include <math.h>
 
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+#include "geometry/vector3.h"
 
 static void set_result(sem_tri_closest *o, const double a[3], const double b[3], const double c[3],
                        double u, double v, double w, sem_tri_feature f, int index, const double p[3])

@@ -12,6 +12,8 @@
 
 #include <embree3/rtcore.h>
 
+#include "geometry/vector3.h"
+
 /* The tessellation as the scene build uses it: vertices (3 doubles each) and triangles (3
  * vertex indices each) with the part of each triangle. */
 typedef struct raw_mesh {
@@ -55,24 +57,6 @@ struct sem_raycast_scene {
     double scale;         /* bounding-box diagonal (> 0) */
     double merge_eps;     /* hits of one part closer than this are one crossing */
 };
-
-/* ---- small vector helpers ---- */
-static inline double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-static inline void sub3(const double *a, const double *b, double *r)
-{
-    r[0] = a[0] - b[0];
-    r[1] = a[1] - b[1];
-    r[2] = a[2] - b[2];
-}
-static inline void cross3(const double *a, const double *b, double *r)
-{
-    r[0] = a[1] * b[2] - a[2] * b[1];
-    r[1] = a[2] * b[0] - a[0] * b[2];
-    r[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 /* Boundary samples per part for the component search (part_orientation.c). */
 #define COMPONENT_SAMPLES 48
