@@ -15,51 +15,36 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5). */
+#include "geometry/point_triangle.h"
+
+/* Closest point on triangle abc to p: the region tests of geometry/point_triangle.h, the
+ * point placed from a vertex along the edge vectors (a + t ab, ...; in the face
+ * a + v ab + w ac with v, w from one reciprocal), as this file always has: the barycentric
+ * blend of sem_point_triangle_closest rounds differently, and these points and distances
+ * feed the weights. */
 static void closest_point_triangle(const double *p, const double *a, const double *b,
                                    const double *c, double *q)
 {
-    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    sem_tri_region r;
+    sem_point_triangle_region(p, a, b, c, &r);
+    if (r.feature == SEM_TRI_VERTEX) {
+        memcpy(q, r.index == 0 ? a : r.index == 1 ? b : c, 3 * sizeof *q);
+        return;
+    }
+    double ab[3], ac[3];
     sub3(b, a, ab);
     sub3(c, a, ac);
-    sub3(p, a, ap);
-    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
-    if (d1 <= 0 && d2 <= 0) {
-        memcpy(q, a, 3 * sizeof *q);
+    if (r.feature == SEM_TRI_EDGE) {
+        if (r.index == 0)
+            for (int k = 0; k < 3; k++) q[k] = a[k] + r.t * ab[k];
+        else if (r.index == 2)
+            for (int k = 0; k < 3; k++) q[k] = a[k] + r.t * ac[k];
+        else
+            for (int k = 0; k < 3; k++) q[k] = b[k] + r.t * (c[k] - b[k]);
         return;
     }
-    sub3(p, b, bp);
-    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
-    if (d3 >= 0 && d4 <= d3) {
-        memcpy(q, b, 3 * sizeof *q);
-        return;
-    }
-    double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        double v = d1 / (d1 - d3);
-        for (int k = 0; k < 3; k++) q[k] = a[k] + v * ab[k];
-        return;
-    }
-    sub3(p, c, cp);
-    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
-    if (d6 >= 0 && d5 <= d6) {
-        memcpy(q, c, 3 * sizeof *q);
-        return;
-    }
-    double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        double w = d2 / (d2 - d6);
-        for (int k = 0; k < 3; k++) q[k] = a[k] + w * ac[k];
-        return;
-    }
-    double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int k = 0; k < 3; k++) q[k] = b[k] + w * (c[k] - b[k]);
-        return;
-    }
-    double denom = 1.0 / (va + vb + vc);
-    double v = vb * denom, w = vc * denom;
+    double denom = 1.0 / (r.va + r.vb + r.vc);
+    double v = r.vb * denom, w = r.vc * denom;
     for (int k = 0; k < 3; k++) q[k] = a[k] + ab[k] * v + ac[k] * w;
 }
 
