@@ -45,8 +45,9 @@ void sem_point_triangle_region(const double p[3], const double a[3], const doubl
     out->vc = vc;
 }
 
-static void set_result(sem_tri_closest *o, const double a[3], const double b[3], const double c[3],
-                       double u, double v, double w, sem_tri_feature f, int index, const double p[3])
+static void set_result(sem_tri_closest *o, const double a[3], const double b[3],
+                       const double c[3], double u, double v, double w, sem_tri_feature f,
+                       int index, const double p[3])
 {
     o->bary[0] = u;
     o->bary[1] = v;

@@ -1,6 +1,6 @@
 /*
  * raycast.h - Embree ray casting against a tessellation of the model's parts (internal):
- * the scene (raycast_build.c), first and all hits (raycast.c), the closest parts
+ * the scene (raycast_build.c), first and all hits (raycast_hits.c), the closest parts
  * (raycast_closest.c), the generalized winding number (winding_number.c) and each part's
  * orientation (part_orientation.c).
  *

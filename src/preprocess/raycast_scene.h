@@ -1,7 +1,7 @@
 /*
  * raycast_scene.h - the Embree scene that the ray casting files share (internal to
  * src/preprocess/; the interface is raycast.h). raycast_build.c builds and frees it;
- * raycast.c casts rays against it (first hit, all hits); raycast_closest.c finds the
+ * raycast_hits.c casts rays against it (first hit, all hits); raycast_closest.c finds the
  * closest point of each part; winding_number.c sums the generalized winding number;
  * part_orientation.c decides each part's orientation while the scene is built.
  */
@@ -61,8 +61,9 @@ struct sem_raycast_scene {
 /* Boundary samples per part for the component search (part_orientation.c). */
 #define COMPONENT_SAMPLES 48
 
-/* raycast.c: all hits in (t_near, t_far), merged and sorted. Returns the count (writes at
- * most max_hits), or -1 when out of memory. use_sign 0: normals before the orientation fix. */
+/* raycast_hits.c: all hits in (t_near, t_far), merged and sorted. Returns the count (writes
+ * at most max_hits), or -1 when out of memory. use_sign 0: normals before the orientation
+ * fix. */
 int sem_raycast_all_hits(const sem_raycast_scene *s, const double *origin, const double *dir,
                          double t_near, double t_far, sem_ray_hit *out, int max_hits, int use_sign);
 

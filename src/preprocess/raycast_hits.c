@@ -1,7 +1,7 @@
 /*
- * raycast.c - rays against the Embree scene of the model's tessellation (Sec. 6.3): the first
- * hit, and all hits merged into crossings and moved onto the exact NURBS surface. The scene
- * is built in raycast_build.c; raycast_scene.h holds what the raycast files share.
+ * raycast_hits.c - rays against the Embree scene of the model's tessellation (Sec. 6.3): the
+ * first hit, and all hits merged into crossings and moved onto the exact NURBS surface. The
+ * scene is built in raycast_build.c; raycast_scene.h holds what the raycast files share.
  *
  * Design
  * - Precision. Embree works in single precision. We keep the tessellation in double and
