@@ -17,12 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/vector3.h"
 #include "sem/nurbs.h"
 
 #define NEWTON_ITERATIONS 40
 #define STARTS 4 /* nearest samples tried when the guess is not good enough */
-
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 sem_status sem_surface_sampler_build(const sem_surface *s, sem_surface_sampler *out,
                                      sem_error *err)

@@ -13,6 +13,7 @@
 #include "contact/collision_topology.h"
 #include "contact/friction.h"
 #include "contact/penalty.h"
+#include "geometry/vector3.h"
 #include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
@@ -146,8 +147,6 @@ void sem_contact_destroy(sem_contact *c)
     sem_point_terms_free(&c->friction_terms);
     free(c);
 }
-
-static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static void normalize3(double a[3])
 {

@@ -18,10 +18,9 @@
  */
 #include <math.h>
 
+#include "geometry/vector3.h"
 #include "sem/nurbs.h"
 #include "steps.h"
-
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 int sem_hit_height_hessian(const sem_surface *surface, double u, double v, const double d[3],
                            const double e1[3], const double e2[3], double H[3],

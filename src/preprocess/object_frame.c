@@ -32,21 +32,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/vector3.h"
 #include "steps.h"
 
 /* Relative gap below which two eigenvalues of C count as equal. */
 #define FRAME_DEGENERATE 1e-6
 /* Relative spread of f below which a direction search has no preferred direction. */
 #define FRAME_FLAT 1e-9
-
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 static void normalize3(double *a)
 {

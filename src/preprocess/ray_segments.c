@@ -6,9 +6,9 @@
  *
  * Inside intervals - robustness choices:
  * 1. Enter/leave counting (CSG union, Fig. 17). With the orientation-corrected normals of
- *    raycast.c, a hit with dir . n < 0 enters a solid, otherwise it leaves. The ray is
- *    inside while the count (depth) is >= 1, so overlapping parts (the mug's embedded
- *    handle, the rocket's fins through its body) are counted once.
+ *    raycast_hits.c (fixed by part_orientation.c), a hit with dir . n < 0 enters a solid,
+ *    otherwise it leaves. The ray is inside while the count (depth) is >= 1, so overlapping
+ *    parts (the mug's embedded handle, the rocket's fins through its body) are counted once.
  * 2. The count is trusted only when it is consistent: it never goes negative and returns
  *    to 0 at the end of the ray. Open surfaces (the rocket has no bottom, the starship is
  *    12 open pieces), gaps (the chicken) or a misoriented part break that. Such a ray falls
@@ -25,7 +25,7 @@
  *    rocket's tube, a lamp shade) keeps winding numbers near or above 1/2, so such solids
  *    keep their counted volume, which is what the modeller meant.
  * 4. Hits on shared edges, duplicate reports and grazing touches are already merged by
- *    sem_raycast_all into single crossings (see raycast.c).
+ *    sem_raycast_all into single crossings (see raycast_hits.c).
  *
  * Material (quad_part): a stack of entered parts along the ray: push the part on entering;
  * on leaving a part remove its most recent occurrence, or, when the part is not on the

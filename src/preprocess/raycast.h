@@ -1,5 +1,8 @@
 /*
- * raycast.h - Embree ray casting against a tessellation of the model's parts.
+ * raycast.h - Embree ray casting against a tessellation of the model's parts (internal):
+ * the scene (raycast_build.c), first and all hits (raycast_hits.c), the closest parts
+ * (raycast_closest.c), the generalized winding number (winding_number.c) and each part's
+ * orientation (part_orientation.c).
  *
  * One Embree triangle geometry per part (geomID = part index), built from
  * sem_mesh_from_model (include/sem/tessellate.h). The paper ray casts a triangulation
@@ -8,8 +11,8 @@
  * part_sign[i] (+1/-1) is the orientation correction of part i: multiplying the part's
  * geometric normal by it makes the normal point out of the solid. CAD files have inward
  * faces (every box-beam section has one), so this is estimated once when the scene is
- * built (see raycast.c for how) and used by the quadrature (enter/leave along a ray) and
- * by the winding-number inside test.
+ * built (see part_orientation.c for how) and used by the quadrature (enter/leave along a
+ * ray) and by the winding-number inside test.
  */
 #ifndef SEM_RAYCAST_H
 #define SEM_RAYCAST_H
@@ -61,11 +64,11 @@ double sem_raycast_winding_number(const sem_raycast_scene *scene, const double X
  * on the shared models): for yes/no decisions with a margin, such as the quadrature's. */
 double sem_raycast_winding_number_coarse(const sem_raycast_scene *scene, const double X[3]);
 /* Is the winding number at X above threshold? Decided by the cheapest far field whose
- * error bound keeps it clear of the threshold (see raycast.c); thread-safe. */
+ * error bound keeps it clear of the threshold (see winding_number.c); thread-safe. */
 int sem_raycast_winding_above(const sem_raycast_scene *scene, const double X[3], double threshold);
 /* The same summed exactly over every triangle (O(triangles)); the function above uses
- * Barill et al.'s (2018) tree with a second-order far field (see raycast.c), equal to this
- * within ~5e-3 away from the surface. */
+ * Barill et al.'s (2018) tree with a second-order far field (see winding_number.c), equal
+ * to this within ~5e-3 away from the surface. */
 double sem_raycast_winding_number_exact(const sem_raycast_scene *scene, const double X[3]);
 /* Bounding box of the tessellation: lo[3], hi[3]. */
 void sem_raycast_bounds(const sem_raycast_scene *scene, double lo[3], double hi[3]);
