@@ -35,6 +35,7 @@
 #include "sem/measure.h"
 #include "sem/nurbs.h"
 #include "sem/trim.h"
+#include "util/free_all.h"
 
 /* Boundary points about this far apart, relative to the model size. */
 #define SPACING 0.01
@@ -224,11 +225,7 @@ static int partner(const sem_surface_sampler *sampler, const sem_trim_region *re
 void sem_seams_free(sem_seams *s)
 {
     if (!s) return;
-    free(s->part);
-    free(s->row_start);
-    free(s->row_ctrl);
-    free(s->row_w);
-    free(s->rest_distance);
+    SEM_FREE_ALL(s->part, s->row_start, s->row_ctrl, s->row_w, s->rest_distance);
     memset(s, 0, sizeof *s);
 }
 
@@ -376,12 +373,7 @@ done:
     for (int p = 0; samplers && p < np; ++p) sem_surface_sampler_free(&samplers[p]);
     for (int p = 0; boundary && p < np; ++p) point_list_free(&boundary[p]);
     for (int p = 0; pairs && p < np; ++p) pair_list_free(&pairs[p]);
-    free(regions);
-    free(samplers);
-    free(boundary);
-    free(pairs);
-    free(box);
-    free(offset);
+    SEM_FREE_ALL(regions, samplers, boundary, pairs, box, offset);
     return st;
 }
 

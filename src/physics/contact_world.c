@@ -13,6 +13,7 @@
 #include "contact/collision_topology.h"
 #include "contact/friction.h"
 #include "contact/penalty.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
@@ -113,11 +114,7 @@ sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem
 
 static void collider_free(collider *k)
 {
-    free(k->vertices);
-    free(k->triangles);
-    free(k->face_normal);
-    free(k->edge_normal);
-    free(k->vertex_normal);
+    SEM_FREE_ALL(k->vertices, k->triangles, k->face_normal, k->edge_normal, k->vertex_normal);
     sem_bvh_free(&k->bvh);
 }
 
@@ -126,15 +123,8 @@ void sem_contact_destroy(sem_contact *c)
     if (!c) return;
     for (int i = 0; i < c->n_colliders; ++i) collider_free(&c->colliders[i]);
     for (int i = 0; i < c->n_objects; ++i) sem_collision_mesh_free(&c->objects[i].mesh);
-    free(c->colliders);
-    free(c->objects);
-    free(c->recs);
-    free(c->slots);
-    free(c->slot_count);
-    free(c->sys_to_contact);
-    free(c->friction);
-    free(c->fweights);
-    free(c->couplings);
+    SEM_FREE_ALL(c->colliders, c->objects, c->recs, c->slots, c->slot_count, c->sys_to_contact, c->friction,
+                 c->fweights, c->couplings);
     sem_point_terms_free(&c->terms);
     sem_point_terms_free(&c->friction_terms);
     free(c);
@@ -797,10 +787,7 @@ sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, doubl
     }
     for (size_t i = 0; i < s->n_dofs; ++i) rhs[i] -= h * g[i];
 done:
-    free(q);
-    free(qpred);
-    free(v);
-    free(g);
+    SEM_FREE_ALL(q, qpred, v, g);
     c->stats.seconds += omp_get_wtime() - t0;
     return st;
 }

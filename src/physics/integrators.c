@@ -14,6 +14,7 @@
 #include "loads.h"
 #include "pins.h"
 #include "runaway.h"
+#include "util/free_all.h"
 
 /*
  * Reusing the rest factor. The step's matrix is A = R + h^2 (K(q_n) - K0) with the rest matrix
@@ -297,14 +298,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         for (size_t i = 0; i < no; ++i) o->q[i] += h * o->v[i];
     }
 done:
-    free(f);
-    free(g);
-    free(rhs);
-    free(tmp);
-    free(vp);
-    free(fr);
-    free(xr);
-    free(work);
+    SEM_FREE_ALL(f, g, rhs, tmp, vp, fr, xr, work);
     return st;
 }
 

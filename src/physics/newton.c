@@ -18,6 +18,7 @@
 #include "loads.h"
 #include "pins.h"
 #include "point_terms.h"
+#include "util/free_all.h"
 
 /* Newton stops as converged after NEWTON_STALL_ITERATIONS full steps in a row, each moving no
  * coordinate by more than NEWTON_STALL_MOVE of the largest coordinate, without halving the
@@ -362,17 +363,6 @@ done:
     if (gathered)
         for (int k = 0; k < s->n_objects; ++k)
             memcpy(s->objects[k]->q, q + s->dof_offset[k], 3 * (size_t)s->objects[k]->n_ctrl * sizeof(double));
-    free(q);
-    free(qn);
-    free(qpred);
-    free(f);
-    free(g);
-    free(tmp);
-    free(dq);
-    free(qtry);
-    free(dir);
-    free(gq);
-    free(adir);
-    free(fr);
+    SEM_FREE_ALL(q, qn, qpred, f, g, tmp, dq, qtry, dir, gq, adir, fr);
     return st;
 }

@@ -37,6 +37,7 @@
  * else the origin of coordinates.
  */
 #include "steps.h"
+#include "util/free_all.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -279,12 +280,6 @@ sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_e
 done:
     if (groups && n_groups > 0)
         for (int g = 0; g < n_groups; ++g) free(groups[g].cost);
-    free(groups);
-    free(assigned);
-    free(group_origin);
-    free(part_origin);
-    free(acc);
-    free(origin_X);
-    free(origin_acc);
+    SEM_FREE_ALL(groups, assigned, group_origin, part_origin, acc, origin_X, origin_acc);
     return st;
 }

@@ -38,6 +38,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 /* A group whose samples' second-moment eigenvalues have a smaller/larger ratio than this is
@@ -310,15 +311,6 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
 done:
-    free(parent);
-    free(join);
-    free(self);
-    free(gself);
-    free(best);
-    free(mom);
-    free(settled);
-    free(any_improving);
-    free(pc);
-    free(gpc);
+    SEM_FREE_ALL(parent, join, self, gself, best, mom, settled, any_improving, pc, gpc);
     return st;
 }

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 
 /* smallest / largest eigenvalue of a symmetric 3x3 (closed form, Smith 1961) */
 static double eig_ratio(const double C[6])
@@ -144,10 +145,7 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err)
     if (n_new != no) {
         double *X = malloc(3 * (size_t)n_new * sizeof(double));
         if (!X) {
-            free(map);
-            free(link);
-            free(alive);
-            free(cent);
+            SEM_FREE_ALL(map, link, alive, cent);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory merging origins");
         }
         for (int i = 0; i < np; ++i) d->part_origin[i] = map[d->part_origin[i]];
@@ -159,9 +157,6 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err)
         d->origin_X = X;
         d->n_origins = n_new;
     }
-    free(map);
-    free(link);
-    free(alive);
-    free(cent);
+    SEM_FREE_ALL(map, link, alive, cent);
     return SEM_OK;
 }

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 /* A boundary sample couples two origins when both carry at least this weight there. */
@@ -184,10 +185,6 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
 done:
-    free(comp);
-    free(merge);
-    free(seen);
-    free(acc);
-    free(pairs);
+    SEM_FREE_ALL(comp, merge, seen, acc, pairs);
     return st;
 }

@@ -40,6 +40,7 @@
 #include <lapacke.h>
 
 #include "quadrature_subrays.h"
+#include "util/free_all.h"
 #include "util/grow.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
@@ -511,16 +512,8 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
             if (!b.offset) continue;
             if (!column(&g, &rays[c], c % g.n[1], c / g.n[1], &b, &cols[c])) failed |= 1;
         }
-        free(b.offset);
-        free(b.volume);
-        free(b.moment);
-        free(b.second);
-        free(b.dvolume);
-        free(b.dmoment);
-        free(b.base_volume);
-        free(b.part);
-        free(b.keep);
-        free(b.entries);
+        SEM_FREE_ALL(b.offset, b.volume, b.moment, b.second, b.dvolume, b.dmoment, b.base_volume, b.part, b.keep,
+                     b.entries);
     }
     if (n_rays)
         for (int c = 0; c < n_columns; ++c) *n_rays += rays[c].rays;

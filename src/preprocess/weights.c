@@ -48,6 +48,7 @@
  * are merged serially in point order, so W is identical for any thread count.
  */
 #include "steps.h"
+#include "util/free_all.h"
 
 #include <limits.h>
 #include <math.h>
@@ -76,10 +77,7 @@ typedef struct weight_candidates {
 
 static void candidates_free(weight_candidates *c)
 {
-    free(c->start);
-    free(c->part);
-    free(c->d_primary);
-    free(c->d_total);
+    SEM_FREE_ALL(c->start, c->part, c->d_primary, c->d_total);
     memset(c, 0, sizeof *c);
 }
 
@@ -309,10 +307,7 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
                 point_offset[p] = base;
                 point_count[p] = (int)(b->n - base);
             }
-            free(parts);
-            free(dist);
-            free(points);
-            free(order);
+            SEM_FREE_ALL(parts, dist, points, order);
         }
     }
 
@@ -346,10 +341,7 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
             free(buffers[t].d_primary);
             free(buffers[t].d_total);
         }
-    free(buffers);
-    free(point_thread);
-    free(point_offset);
-    free(point_count);
+    SEM_FREE_ALL(buffers, point_thread, point_offset, point_count);
     if (failed) {
         candidates_free(out);
         return SEM_ERR_NOMEM;

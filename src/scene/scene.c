@@ -17,6 +17,7 @@
 #include "io/read_file.h"
 #include "sem/limits.h"
 #include "sem/primitives.h"
+#include "util/free_all.h"
 
 typedef struct ctx {
     const char *name;
@@ -938,11 +939,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
 
 static void object_free(sem_scene_object *o)
 {
-    free(o->part_materials);
-    free(o->pin_parts);
-    free(o->pin_points);
-    free(o->point_loads);
-    free(o->region_loads);
+    SEM_FREE_ALL(o->part_materials, o->pin_parts, o->pin_points, o->point_loads, o->region_loads);
     for (int k = 0; k < o->n_prescribe_groups; ++k) {
         free(o->prescribe_groups[k].parts);
         free(o->prescribe_groups[k].points);

@@ -26,6 +26,7 @@
 #include "sem/refine.h"
 #include "sem/scene.h"
 #include "sem/tessellate.h"
+#include "util/free_all.h"
 
 struct sem_scene_world {
     const sem_scene *scene;
@@ -131,17 +132,8 @@ void sem_scene_world_destroy(sem_scene_world *sw)
         if (sw->prescribes) free(sw->prescribes[i]);
         if (sw->materials) free(sw->materials[i]);
     }
-    free(sw->models);
-    free(sw->patches);
-    free(sw->discs);
-    free(sw->pins);
-    free(sw->part_material);
-    free(sw->prescribe_group);
-    free(sw->prescribes);
-    free(sw->materials);
-    free(sw->file_unit_to_meter);
-    free(sw->file_units);
-    free(sw->spurious);
+    SEM_FREE_ALL(sw->models, sw->patches, sw->discs, sw->pins, sw->part_material, sw->prescribe_group, sw->prescribes,
+                 sw->materials, sw->file_unit_to_meter, sw->file_units, sw->spurious);
     free(sw);
 }
 
