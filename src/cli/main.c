@@ -150,17 +150,22 @@ static const cli_command *find_command(const char *name)
 
 /* ---- messages ---- */
 
-int cli_fail(const char *fmt, ...)
+/* "sem: ", the prefix, then the message on one line, whatever it contains. */
+static void print_one_line(const char *prefix, const char *fmt, va_list ap)
 {
     char buf[2048];
-    va_list ap;
-    va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    /* one line, whatever the message contains */
     for (char *c = buf; *c; ++c)
         if (*c == '\n' || *c == '\r') *c = ' ';
-    fprintf(stderr, "sem: %s\n", buf);
+    fprintf(stderr, "sem: %s%s\n", prefix, buf);
+}
+
+int cli_fail(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    print_one_line("", fmt, ap);
+    va_end(ap);
     return CLI_FAILED;
 }
 
@@ -190,14 +195,10 @@ int cli_usage(const char *command, const char *fmt, ...)
 
 void cli_warn(const char *fmt, ...)
 {
-    char buf[2048];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    print_one_line("warning: ", fmt, ap);
     va_end(ap);
-    for (char *c = buf; *c; ++c)
-        if (*c == '\n' || *c == '\r') *c = ' ';
-    fprintf(stderr, "sem: warning: %s\n", buf);
 }
 
 void cli_print_model_warnings(const sem_model *model)
