@@ -412,6 +412,33 @@ static int max_candidates(const weight_candidates *c)
     return most;
 }
 
+/* evaluate_row's scratch, one per thread: room for the most candidates any point has. Both
+ * NULL, and *failed set, when out of memory. */
+typedef struct row_scratch {
+    int *cols;
+    double *vals;
+} row_scratch;
+
+static row_scratch row_scratch_alloc(int most, int *failed)
+{
+    row_scratch r = {malloc((size_t)most * sizeof *r.cols), malloc((size_t)most * sizeof *r.vals)};
+    if (!r.cols || !r.vals) {
+        free(r.cols);
+        free(r.vals);
+        r.cols = NULL;
+        r.vals = NULL;
+#pragma omp atomic write
+        *failed = 1;
+    }
+    return r;
+}
+
+static void row_scratch_free(row_scratch *r)
+{
+    free(r->cols);
+    free(r->vals);
+}
+
 /* Number of non-zero weights at cut-off alpha, or -1 when out of memory. */
 static long long count_nonzeros(const weight_candidates *c, double alpha, double threshold,
                                 int n_threads)
@@ -421,17 +448,11 @@ static long long count_nonzeros(const weight_candidates *c, double alpha, double
     int failed = 0;
 #pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1) reduction(+ : nnz)
     {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
-        }
+        row_scratch r = row_scratch_alloc(most, &failed);
 #pragma omp for schedule(static)
         for (int p = 0; p < c->n_points; ++p)
-            if (cols && vals) nnz += evaluate_row(c, p, alpha, threshold, cols, vals);
-        free(cols);
-        free(vals);
+            if (r.cols) nnz += evaluate_row(c, p, alpha, threshold, r.cols, r.vals);
+        row_scratch_free(&r);
     }
     return failed ? -1 : nnz;
 }
@@ -446,49 +467,35 @@ static sem_status build_matrix(const weight_candidates *c, int n_parts, double a
     int *length = malloc(((size_t)n + 1) * sizeof *length);
     if (!length) return SEM_ERR_NOMEM;
     int failed = 0;
+    /* Two passes over the rows with the same scratch: their lengths, then (with W sized) the
+     * rows themselves. evaluate_row uses room for every candidate before dropping small
+     * weights, so rows are evaluated in scratch and copied. */
 #pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1)
     {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
-        }
+        row_scratch r = row_scratch_alloc(most, &failed);
 #pragma omp for schedule(static)
         for (int p = 0; p < n; ++p)
-            length[p] = (cols && vals) ? evaluate_row(c, p, alpha, threshold, cols, vals) : 0;
-        free(cols);
-        free(vals);
-    }
-    size_t nnz = 0;
-    for (int p = 0; p < n; ++p) nnz += (size_t)length[p];
-    if (failed || nnz > (size_t)INT_MAX || sem_csr_alloc(W, n, n_parts, nnz) != SEM_OK) {
-        free(length);
-        sem_csr_free(W);
-        return SEM_ERR_NOMEM;
-    }
-    W->row_start[0] = 0;
-    for (int p = 0; p < n; ++p) W->row_start[p + 1] = W->row_start[p] + length[p];
-    /* evaluate_row uses room for every candidate before dropping small weights, so rows
-     * are evaluated in scratch and copied */
-#pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1)
-    {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
+            length[p] = r.cols ? evaluate_row(c, p, alpha, threshold, r.cols, r.vals) : 0;
+#pragma omp single
+        {
+            size_t nnz = 0;
+            for (int p = 0; p < n; ++p) nnz += (size_t)length[p];
+            if (failed || nnz > (size_t)INT_MAX || sem_csr_alloc(W, n, n_parts, nnz) != SEM_OK) {
+                failed = 1;
+            } else {
+                W->row_start[0] = 0;
+                for (int p = 0; p < n; ++p) W->row_start[p + 1] = W->row_start[p] + length[p];
+            }
         }
 #pragma omp for schedule(static)
         for (int p = 0; p < n; ++p) {
-            if (!cols || !vals) continue;
+            if (failed || !r.cols) continue;
             const int at = W->row_start[p];
-            const int m = evaluate_row(c, p, alpha, threshold, cols, vals);
-            memcpy(&W->col[at], cols, (size_t)m * sizeof *cols);
-            memcpy(&W->val[at], vals, (size_t)m * sizeof *vals);
+            const int m = evaluate_row(c, p, alpha, threshold, r.cols, r.vals);
+            memcpy(&W->col[at], r.cols, (size_t)m * sizeof *r.cols);
+            memcpy(&W->val[at], r.vals, (size_t)m * sizeof *r.vals);
         }
-        free(cols);
-        free(vals);
+        row_scratch_free(&r);
     }
     free(length);
     if (failed) {
