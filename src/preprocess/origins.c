@@ -189,6 +189,15 @@ static sem_status solve_assignment(const sem_discretization *d, const origin_gro
     return SEM_OK;
 }
 
+void sem_set_origins(sem_discretization *d, double *origin_X, int *part_origin, int n_origins)
+{
+    free(d->origin_X);
+    free(d->part_origin);
+    d->origin_X = origin_X;
+    d->part_origin = part_origin;
+    d->n_origins = n_origins;
+}
+
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err)
 {
     (void)model;
@@ -269,11 +278,7 @@ sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_e
                 origin_X[3 * (size_t)j + e] = o[4 + e] / o[7];
         }
     }
-    free(d->origin_X);
-    free(d->part_origin);
-    d->n_origins = n_origins;
-    d->origin_X = origin_X;
-    d->part_origin = part_origin;
+    sem_set_origins(d, origin_X, part_origin, n_origins);
     part_origin = NULL;
     origin_X = NULL;
 

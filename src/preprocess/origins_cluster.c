@@ -285,11 +285,7 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
                 for (int e = 0; e < 3; ++e) x[e] = mi[1 + e] / mi[0];
         }
         free(root_origin);
-        free(d->origin_X);
-        free(d->part_origin);
-        d->origin_X = X;
-        d->part_origin = part_origin;
-        d->n_origins = n_origins;
+        sem_set_origins(d, X, part_origin, n_origins);
     }
     goto done;
 nomem:

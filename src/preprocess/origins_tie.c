@@ -98,11 +98,7 @@ sem_status sem_merge_origins(sem_discretization *d, int *merge, sem_error *err)
         if (A[o] > 0)
             for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] /= A[o];
     free(A);
-    free(d->origin_X);
-    free(d->part_origin);
-    d->origin_X = X;
-    d->part_origin = part_origin;
-    d->n_origins = n_new;
+    sem_set_origins(d, X, part_origin, n_new);
     return SEM_OK;
 }
 

@@ -122,6 +122,9 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
 
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+/* origins.c: d's origins become these (d takes the arrays; the old ones are freed): every
+ * origin rule ends here. */
+void sem_set_origins(sem_discretization *d, double *origin_X, int *part_origin, int n_origins);
 /* origins_cluster.c: the default rule (SEM_ORIGINS_COUPLED): fills n_origins, origin_X,
  * part_origin by merging flat groups of parts with the parts they blend with most. */
 sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err);
