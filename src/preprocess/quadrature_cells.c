@@ -385,20 +385,7 @@ static double refine(const sem_discretization *d, cell_grid *g, int max_level)
         free(box);
         return -1;
     }
-    for (int p = 0; p < np; ++p)
-        for (int e = 0; e < 3; ++e) {
-            box[6 * p + e] = INFINITY;
-            box[6 * p + 3 + e] = -INFINITY;
-        }
-    for (int s = 0; s < d->n_samples; ++s) {
-        double Y[3];
-        sem_frame_coordinates(d, d->sample_X + 3 * (size_t)s, Y);
-        double *bx = box + 6 * (size_t)d->sample_part[s];
-        for (int e = 0; e < 3; ++e) {
-            bx[e] = fmin(bx[e], Y[e]);
-            bx[3 + e] = fmax(bx[3 + e], Y[e]);
-        }
-    }
+    sem_part_frame_boxes(d, box);
     const double h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     for (int p = 0; p < np; ++p) {
         double want = size[p] / SMALL_PART_CELLS;

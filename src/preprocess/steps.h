@@ -26,6 +26,9 @@ int sem_samples_by_part(const sem_discretization *d, int **start, int **index);
 /* object_frame.c: fills frame_axes, frame_center, frame_lo, frame_hi from the scene's
  * tessellation (principal axes of the surface, degenerate ones fixed by the normals). */
 sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d, sem_error *err);
+/* Every part's bounding box of its boundary samples in the frame (sem_frame_coordinates):
+ * 6 numbers a part, lower then upper corner (+inf then -inf for a part without samples). */
+void sem_part_frame_boxes(const sem_discretization *d, double *box);
 /* Size of every part (the diagonal of its boundary samples' bounding box in the frame, so it
  * does not change when the object is turned; 0 for a part without samples) into size (may be
  * NULL, n_parts entries) and the median over parts with samples into *median (may be NULL). */
