@@ -36,6 +36,7 @@
 #include "sem/nurbs.h"
 #include "sem/trim.h"
 #include "util/free_all.h"
+#include "util/grow.h"
 
 /* Boundary points about this far apart, relative to the model size. */
 #define SPACING 0.01
@@ -53,12 +54,9 @@ static int point_push(point_list *l, const double uv[2], const double X[3])
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
-        double *a = realloc(l->uv, (size_t)cap * 2 * sizeof(double));
-        if (!a) return -1;
-        l->uv = a;
-        double *b = realloc(l->X, (size_t)cap * 3 * sizeof(double));
-        if (!b) return -1;
-        l->X = b;
+        if (!sem_resize((void **)&l->uv, (size_t)cap * 2, sizeof(double)) ||
+            !sem_resize((void **)&l->X, (size_t)cap * 3, sizeof(double)))
+            return -1;
         l->cap = cap;
     }
     memcpy(l->uv + 2 * (size_t)l->n, uv, 2 * sizeof(double));
@@ -168,15 +166,10 @@ static int pair_push(pair_list *l, int a, const double uva[2], int b, const doub
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
-        int *p = realloc(l->part, (size_t)cap * 2 * sizeof(int));
-        if (!p) return -1;
-        l->part = p;
-        double *u = realloc(l->uv, (size_t)cap * 4 * sizeof(double));
-        if (!u) return -1;
-        l->uv = u;
-        double *r = realloc(l->rest, (size_t)cap * sizeof(double));
-        if (!r) return -1;
-        l->rest = r;
+        if (!sem_resize((void **)&l->part, (size_t)cap * 2, sizeof(int)) ||
+            !sem_resize((void **)&l->uv, (size_t)cap * 4, sizeof(double)) ||
+            !sem_resize((void **)&l->rest, (size_t)cap, sizeof(double)))
+            return -1;
         l->cap = cap;
     }
     l->part[2 * l->n] = a;

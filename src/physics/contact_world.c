@@ -4,6 +4,7 @@
  */
 #include "contact_world.h"
 
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -14,6 +15,7 @@
 #include "contact/friction.h"
 #include "contact/penalty.h"
 #include "util/free_all.h"
+#include "util/grow.h"
 #include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
@@ -711,26 +713,11 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         double lambda = r->stiffness * (r->thickness - r->d);
         if (!(r->mu > 0) || !(lambda > 0)) continue;
         int n = rec_weights(c, r, w);
-        if (c->n_friction == c->cap_friction) {
-            int cap = c->cap_friction ? 2 * c->cap_friction : 256;
-            friction_rec *x = realloc(c->friction, (size_t)cap * sizeof *x);
-            if (!x) {
-                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
-                break;
-            }
-            c->friction = x;
-            c->cap_friction = cap;
-        }
-        if (c->n_fweights + n > c->cap_fweights) {
-            int cap = c->cap_fweights ? 2 * c->cap_fweights : 4096;
-            while (cap < c->n_fweights + n) cap *= 2;
-            sem_point_weight *x = realloc(c->fweights, (size_t)cap * sizeof *x);
-            if (!x) {
-                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
-                break;
-            }
-            c->fweights = x;
-            c->cap_fweights = cap;
+        if (!sem_grow((void **)&c->friction, &c->cap_friction, c->n_friction + 1, sizeof *c->friction, 256, INT_MAX) ||
+            !sem_grow((void **)&c->fweights, &c->cap_fweights, c->n_fweights + n, sizeof *c->fweights, 4096,
+                      INT_MAX)) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+            break;
         }
         friction_rec *fr = &c->friction[c->n_friction++];
         fr->first = c->n_fweights;

@@ -184,27 +184,13 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
     const int n_cells = b->offset[n0];
     if (!grow((void **)&b->volume, &b->cap_cells, n_cells, sizeof *b->volume)) return 0;
     const size_t cap = (size_t)b->cap_cells;
-    double *m = realloc(b->moment, 3 * cap * sizeof *m);
-    if (!m) return 0;
-    b->moment = m;
-    double *m2 = realloc(b->second, 6 * cap * sizeof *m2);
-    if (!m2) return 0;
-    b->second = m2;
-    double *dv = realloc(b->dvolume, cap * sizeof *dv);
-    if (!dv) return 0;
-    b->dvolume = dv;
-    double *dm = realloc(b->dmoment, 3 * cap * sizeof *dm);
-    if (!dm) return 0;
-    b->dmoment = dm;
-    double *bv = realloc(b->base_volume, cap * sizeof *bv);
-    if (!bv) return 0;
-    b->base_volume = bv;
-    int *cp = realloc(b->part, cap * sizeof *cp);
-    if (!cp) return 0;
-    b->part = cp;
-    unsigned char *kp = realloc(b->keep, cap);
-    if (!kp) return 0;
-    b->keep = kp;
+    if (!sem_resize((void **)&b->moment, 3 * cap, sizeof *b->moment) ||
+        !sem_resize((void **)&b->second, 6 * cap, sizeof *b->second) ||
+        !sem_resize((void **)&b->dvolume, cap, sizeof *b->dvolume) ||
+        !sem_resize((void **)&b->dmoment, 3 * cap, sizeof *b->dmoment) ||
+        !sem_resize((void **)&b->base_volume, cap, sizeof *b->base_volume) ||
+        !sem_resize((void **)&b->part, cap, sizeof *b->part) || !sem_resize((void **)&b->keep, cap, 1))
+        return 0;
     memset(b->volume, 0, (size_t)n_cells * sizeof *b->volume);
     memset(b->moment, 0, 3 * (size_t)n_cells * sizeof *b->moment);
     memset(b->second, 0, 6 * (size_t)n_cells * sizeof *b->second);

@@ -49,6 +49,7 @@
  */
 #include "steps.h"
 #include "util/free_all.h"
+#include "util/grow.h"
 
 #include <limits.h>
 #include <math.h>
@@ -93,15 +94,10 @@ static int buffer_reserve(candidate_buffer *b, size_t extra)
     if (b->n + extra <= b->cap) return 1;
     size_t cap = b->cap ? b->cap : 256;
     while (cap < b->n + extra) cap *= 2;
-    int *p = realloc(b->part, cap * sizeof *p);
-    if (!p) return 0;
-    b->part = p;
-    double *dp = realloc(b->d_primary, cap * sizeof *dp);
-    if (!dp) return 0;
-    b->d_primary = dp;
-    double *dt = realloc(b->d_total, cap * sizeof *dt);
-    if (!dt) return 0;
-    b->d_total = dt;
+    if (!sem_resize((void **)&b->part, cap, sizeof *b->part) ||
+        !sem_resize((void **)&b->d_primary, cap, sizeof *b->d_primary) ||
+        !sem_resize((void **)&b->d_total, cap, sizeof *b->d_total))
+        return 0;
     b->cap = cap;
     return 1;
 }
