@@ -247,15 +247,9 @@ sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def,
         }
     } else
         return sem_error_set(err, SEM_ERR_INVALID, "unknown collider type %d", (int)def->type);
-    if (c->n_colliders == c->cap_colliders) {
-        int cap = c->cap_colliders ? 2 * c->cap_colliders : 4;
-        collider *x = realloc(c->colliders, (size_t)cap * sizeof *x);
-        if (!x) {
-            collider_free(&k);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        c->colliders = x;
-        c->cap_colliders = cap;
+    if (!sem_grow((void **)&c->colliders, &c->cap_colliders, c->n_colliders + 1, sizeof *c->colliders, 4, INT_MAX)) {
+        collider_free(&k);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     c->colliders[c->n_colliders++] = k;
     c->stats.colliders = c->n_colliders;
@@ -264,13 +258,8 @@ sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def,
 
 sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error *err)
 {
-    if (c->n_objects == c->cap_objects) {
-        int cap = c->cap_objects ? 2 * c->cap_objects : 4;
-        contact_object *x = realloc(c->objects, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        c->objects = x;
-        c->cap_objects = cap;
-    }
+    if (!sem_grow((void **)&c->objects, &c->cap_objects, c->n_objects + 1, sizeof *c->objects, 4, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     contact_object *co = &c->objects[c->n_objects];
     memset(co, 0, sizeof *co);
     co->object = o;
@@ -337,13 +326,8 @@ static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err
 
 static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
 {
-    if (c->n_recs == c->cap_recs) {
-        int cap = c->cap_recs ? 2 * c->cap_recs : 256;
-        contact_rec *x = realloc(c->recs, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
-        c->recs = x;
-        c->cap_recs = cap;
-    }
+    if (!sem_grow((void **)&c->recs, &c->cap_recs, c->n_recs + 1, sizeof *c->recs, 256, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
     c->recs[c->n_recs++] = *r;
     return SEM_OK;
 }
@@ -649,13 +633,8 @@ static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_erro
         for (int j = 0; j < c->n_couplings && !seen; ++j)
             seen = !memcmp(&c->couplings[j], &cp, sizeof cp);
         if (seen) continue;
-        if (c->n_couplings == c->cap_couplings) {
-            int cap = c->cap_couplings ? 2 * c->cap_couplings : 64;
-            sem_system_coupling *x = realloc(c->couplings, (size_t)cap * sizeof *x);
-            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-            c->couplings = x;
-            c->cap_couplings = cap;
-        }
+        if (!sem_grow((void **)&c->couplings, &c->cap_couplings, c->n_couplings + 1, sizeof *c->couplings, 64, INT_MAX))
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         c->couplings[c->n_couplings++] = cp;
     }
     return SEM_OK;
