@@ -286,11 +286,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         }
         sem_system_scatter_free(s, fr, vp);
     }
-    for (size_t i = 0; i < n; ++i)
-        if (!isfinite(vp[i])) {
-            st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
-            goto done;
-        }
+    if ((st = sem_runaway_check_finite(vp, n, t1, err)) != SEM_OK) goto done;
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t no = 3 * (size_t)o->n_ctrl;
