@@ -92,11 +92,9 @@ int cmd_probe(int argc, char **argv)
             if (rc != CLI_OK) return rc;
             if (slack < 0) return cli_usage(CMD, "--slack must be >= 0");
             ++i;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage(CMD, "unknown option '%s'", argv[i]);
         } else {
-            if (n == 3) return cli_usage(CMD, "too many arguments ('%s')", argv[i]);
-            files[n++] = argv[i];
+            int rc = cli_take_file(CMD, argv[i], files, &n, 3);
+            if (rc != CLI_OK) return rc;
         }
     }
     if (n < 3) return cli_usage(CMD, "need REST, FRAME and POINTS");

@@ -286,6 +286,14 @@ int cli_need_values(const char *command, int argc, char **argv, int i, int count
     return CLI_OK;
 }
 
+int cli_take_file(const char *command, const char *arg, const char **files, int *n, int most)
+{
+    if (arg[0] == '-' && arg[1] != '\0') return cli_usage(command, "unknown option '%s'", arg);
+    if (*n == most) return cli_usage(command, "too many arguments ('%s')", arg);
+    files[(*n)++] = arg;
+    return CLI_OK;
+}
+
 int cli_is_help(const char *arg)
 {
     return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
