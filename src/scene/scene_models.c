@@ -71,6 +71,15 @@ sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model *
     return sem_scene_object_model_units(scene, index, out, NULL, NULL, err);
 }
 
+/* Puts "name: where<key>: " before err's message (the step that failed, told where). */
+static void name_where(sem_error *err, sem_status st, const char *name, const char *where, const char *key)
+{
+    if (!err) return;
+    char msg[sizeof err->message];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    sem_error_set(err, st, "%s: %s%s: %s", name, where, key, msg);
+}
+
 /* The model of an object's or a collider's shape (where: "objects[0]", "colliders[1]"), in
  * metres and transformed. */
 static sem_status shape_model(const sem_scene *scene, const sem_scene_object *o, const char *where,
@@ -83,11 +92,7 @@ static sem_status shape_model(const sem_scene *scene, const sem_scene_object *o,
         st = sem_model_load(o->model_path, &m, err);
         if (st != SEM_OK) {
             /* always name the key: "scene.json: objects[0].model: dir/x.igs: cannot open: ..." */
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s.model: %s", scene->path[0] ? scene->path : "scene", where, msg);
-            }
+            name_where(err, st, scene->path[0] ? scene->path : "scene", where, ".model");
             return st;
         }
     } else {
@@ -187,11 +192,7 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
         /* a plain triangle mesh, unless the file holds free-form surfaces */
         st = sem_obj_triangles_read(o->model_path, &soup, &freeform, err);
         if (st != SEM_OK) {
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s.model: %s", name, where, msg);
-            }
+            name_where(err, st, name, where, ".model");
             return st;
         }
     }
@@ -213,11 +214,7 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
         st = sem_mesh_from_model(m, COLLIDER_RESOLUTION, &mesh, err);
         sem_model_destroy(m);
         if (st != SEM_OK) {
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s: %s", name, where, msg);
-            }
+            name_where(err, st, name, where, "");
             return st;
         }
         soup.n_vertices = mesh.n_vertices;
