@@ -78,6 +78,9 @@ int cli_parse_double(const char *command, const char *option, const char *text, 
 int cli_parse_int(const char *command, const char *option, const char *text, int *out);
 /* Makes sure option argv[i] has `count` values after it; prints a usage error if not. */
 int cli_need_values(const char *command, int argc, char **argv, int i, int count);
+/* An argument that is none of the command's options: a usage error when it looks like an
+ * option ('-' and more) or when files[] already holds `most`; else the next of files[]. */
+int cli_take_file(const char *command, const char *arg, const char **files, int *n, int most);
 /* 1 for "--help" / "-h". */
 int cli_is_help(const char *arg);
 

@@ -14,10 +14,8 @@ int cmd_convert(int argc, char **argv)
     const char *files[2] = {NULL, NULL};
     int n = 0;
     for (int i = 1; i < argc; ++i) {
-        if (argv[i][0] == '-' && argv[i][1] != '\0')
-            return cli_usage(CMD, "unknown option '%s'", argv[i]);
-        if (n == 2) return cli_usage(CMD, "too many arguments ('%s')", argv[i]);
-        files[n++] = argv[i];
+        int rc = cli_take_file(CMD, argv[i], files, &n, 2);
+        if (rc != CLI_OK) return rc;
     }
     if (n < 2) return cli_usage(CMD, "need IN and OUT files");
 

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_folder.h"
 #include "geometry/model_locator.h"
 #include "sem/nurbs.h"
 
@@ -79,18 +80,6 @@ static int read_points(const char *path, double **xyz, long *count)
     return CLI_OK;
 }
 
-/* FRAME must be REST with moved control points. */
-static int same_structure(const sem_model *rest, const sem_model *frame)
-{
-    if (rest->n_parts != frame->n_parts) return 0;
-    for (int i = 0; i < rest->n_parts; ++i) {
-        const sem_surface *a = &rest->parts[i].surface, *b = &frame->parts[i].surface;
-        if (a->degree_u != b->degree_u || a->degree_v != b->degree_v || a->n_u != b->n_u || a->n_v != b->n_v)
-            return 0;
-    }
-    return 1;
-}
-
 int cmd_probe(int argc, char **argv)
 {
     const char *files[3] = {NULL, NULL, NULL};
@@ -103,11 +92,9 @@ int cmd_probe(int argc, char **argv)
             if (rc != CLI_OK) return rc;
             if (slack < 0) return cli_usage(CMD, "--slack must be >= 0");
             ++i;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage(CMD, "unknown option '%s'", argv[i]);
         } else {
-            if (n == 3) return cli_usage(CMD, "too many arguments ('%s')", argv[i]);
-            files[n++] = argv[i];
+            int rc = cli_take_file(CMD, argv[i], files, &n, 3);
+            if (rc != CLI_OK) return rc;
         }
     }
     if (n < 3) return cli_usage(CMD, "need REST, FRAME and POINTS");
@@ -125,7 +112,7 @@ int cmd_probe(int argc, char **argv)
         rc = cli_fail_error(files[1], &err);
         goto done;
     }
-    if (!same_structure(rest, frame)) {
+    if (!run_frame_matches(rest, frame)) {
         rc = cli_fail("%s: not a frame of %s (different parts or control grids)", files[1], files[0]);
         goto done;
     }

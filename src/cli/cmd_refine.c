@@ -24,11 +24,9 @@ int cmd_refine(int argc, char **argv)
                 return cli_usage(CMD, "%s: %d is outside 1..%d", argv[i], factor,
                                  SEM_MAX_REFINE_FACTOR);
             ++i;
-        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            return cli_usage(CMD, "unknown option '%s'", argv[i]);
         } else {
-            if (n == 2) return cli_usage(CMD, "too many arguments ('%s')", argv[i]);
-            files[n++] = argv[i];
+            int rc = cli_take_file(CMD, argv[i], files, &n, 2);
+            if (rc != CLI_OK) return rc;
         }
     }
     if (n < 2) return cli_usage(CMD, "need IN and OUT files");

@@ -24,6 +24,7 @@
 #include "cli.h"
 #include "io/atomic_file.h"
 #include "run_folder.h"
+#include "util/free_all.h"
 
 #define CMD "view"
 
@@ -42,11 +43,7 @@ typedef struct view_assets {
 
 static void assets_free(view_assets *a)
 {
-    free(a->three);
-    free(a->gltf_loader);
-    free(a->orbit_controls);
-    free(a->summary);
-    free(a->glb);
+    SEM_FREE_ALL(a->three, a->gltf_loader, a->orbit_controls, a->summary, a->glb);
 }
 
 /* Reads dir/name (first of the candidates that exists); NULL and a message when none. */

@@ -150,17 +150,22 @@ static const cli_command *find_command(const char *name)
 
 /* ---- messages ---- */
 
-int cli_fail(const char *fmt, ...)
+/* "sem: ", the prefix, then the message on one line, whatever it contains. */
+static void print_one_line(const char *prefix, const char *fmt, va_list ap)
 {
     char buf[2048];
-    va_list ap;
-    va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    /* one line, whatever the message contains */
     for (char *c = buf; *c; ++c)
         if (*c == '\n' || *c == '\r') *c = ' ';
-    fprintf(stderr, "sem: %s\n", buf);
+    fprintf(stderr, "sem: %s%s\n", prefix, buf);
+}
+
+int cli_fail(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    print_one_line("", fmt, ap);
+    va_end(ap);
     return CLI_FAILED;
 }
 
@@ -190,14 +195,10 @@ int cli_usage(const char *command, const char *fmt, ...)
 
 void cli_warn(const char *fmt, ...)
 {
-    char buf[2048];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    print_one_line("warning: ", fmt, ap);
     va_end(ap);
-    for (char *c = buf; *c; ++c)
-        if (*c == '\n' || *c == '\r') *c = ' ';
-    fprintf(stderr, "sem: warning: %s\n", buf);
 }
 
 void cli_print_model_warnings(const sem_model *model)
@@ -282,6 +283,14 @@ int cli_need_values(const char *command, int argc, char **argv, int i, int count
 {
     if (i + count >= argc)
         return cli_usage(command, "%s needs %d value%s", argv[i], count, count == 1 ? "" : "s");
+    return CLI_OK;
+}
+
+int cli_take_file(const char *command, const char *arg, const char **files, int *n, int most)
+{
+    if (arg[0] == '-' && arg[1] != '\0') return cli_usage(command, "unknown option '%s'", arg);
+    if (*n == most) return cli_usage(command, "too many arguments ('%s')", arg);
+    files[(*n)++] = arg;
     return CLI_OK;
 }
 

@@ -24,6 +24,7 @@
 #include "cli.h"
 #include "render_input.h"
 #include "sem/render.h"
+#include "util/free_all.h"
 
 int render_colors_parse(const char *text, render_color_mode *mode, int *part)
 {
@@ -293,9 +294,6 @@ void render_colors_free(render_colors *c, int n_objects)
 {
     if (c->discs)
         for (int o = 0; o < n_objects; ++o) sem_discretization_destroy(c->discs[o]);
-    free(c->discs);
-    free(c->vertex_colors);
-    free(c->point_colors);
-    free(c->object_first_point);
+    SEM_FREE_ALL(c->discs, c->vertex_colors, c->point_colors, c->object_first_point);
     memset(c, 0, sizeof *c);
 }

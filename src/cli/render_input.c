@@ -19,18 +19,6 @@
 
 #include <omp.h>
 
-/* Same parts, degrees and control grids as the reference (only control points move). */
-static int same_topology(const sem_model *a, const sem_model *b)
-{
-    if (a->n_parts != b->n_parts) return 0;
-    for (int i = 0; i < a->n_parts; ++i) {
-        const sem_surface *s = &a->parts[i].surface, *t = &b->parts[i].surface;
-        if (s->n_u != t->n_u || s->n_v != t->n_v || s->degree_u != t->degree_u || s->degree_v != t->degree_v)
-            return 0;
-    }
-    return 1;
-}
-
 static void bounds_add(double b[6], const sem_mesh *m)
 {
     for (int v = 0; v < m->n_vertices; ++v)
@@ -129,7 +117,7 @@ static sem_status read_frames(render_input *in, sem_error *err)
                 sem_model *m = NULL;
                 if (sem_model_load(path, &m, &e) != SEM_OK) {
                     bad = 1;
-                } else if (!same_topology(m, in->rest)) {
+                } else if (!run_frame_matches(in->rest, m)) {
                     sem_error_set(&e, SEM_ERR_INVALID,
                                   "%s: not the same model as frame 0 (%d parts, frame 0 has %d, or other grids)",
                                   path, m->n_parts, in->rest->n_parts);

@@ -17,6 +17,17 @@
 #include <string.h>
 #include <sys/stat.h>
 
+int run_frame_matches(const sem_model *rest, const sem_model *frame)
+{
+    if (rest->n_parts != frame->n_parts) return 0;
+    for (int i = 0; i < rest->n_parts; ++i) {
+        const sem_surface *a = &rest->parts[i].surface, *b = &frame->parts[i].surface;
+        if (a->degree_u != b->degree_u || a->degree_v != b->degree_v || a->n_u != b->n_u || a->n_v != b->n_v)
+            return 0;
+    }
+    return 1;
+}
+
 char *read_text_file(const char *path, size_t *size)
 {
     FILE *f = fopen(path, "rb");

@@ -11,6 +11,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "sem/model.h"
 #include "sem/status.h"
 
 typedef struct run_folder {
@@ -31,6 +32,10 @@ void run_folder_close(run_folder *rf);
 void run_folder_frame_path(const run_folder *rf, int frame, char *out, size_t size);
 /* An object's entry of summary.json's "objects", or NULL. */
 const cJSON *run_folder_object(const run_folder *rf, int object);
+
+/* Is frame a frame of rest: the same parts, degrees and control grids (only control points
+ * move)? */
+int run_frame_matches(const sem_model *rest, const sem_model *frame);
 
 /* Whole file into a NUL-terminated buffer (caller frees); NULL when it cannot be read. */
 char *read_text_file(const char *path, size_t *size);

@@ -13,6 +13,7 @@
 #include "collision_topology.h"
 #include "geometry/weld_points.h"
 #include "narrow_phase.h"
+#include "util/free_all.h"
 
 /* Points closer than this x the object size at rest are one point of the surface. */
 #define WELD_TOLERANCE 1e-4
@@ -172,13 +173,7 @@ static sem_status orient_parts(sem_collision_mesh *m, const sem_mesh *mesh, sem_
     }
     if (turned) st = sem_collision_edge_neighbours(m->triangles, nt, m->weld, m->edge_other, err);
 done:
-    free(tri_part);
-    free(flip);
-    free(group);
-    free(queue);
-    free(first);
-    free(volume);
-    free(links);
+    SEM_FREE_ALL(tri_part, flip, group, queue, first, volume, links);
     return st;
 }
 
@@ -228,17 +223,8 @@ static void update_normals(sem_collision_mesh *m)
 
 void sem_collision_mesh_free(sem_collision_mesh *m)
 {
-    free(m->row_start);
-    free(m->row_ctrl);
-    free(m->row_w);
-    free(m->area);
-    free(m->triangles);
-    free(m->x);
-    free(m->x0);
-    free(m->pseudo_normal);
-    free(m->face_normal);
-    free(m->weld);
-    free(m->edge_other);
+    SEM_FREE_ALL(m->row_start, m->row_ctrl, m->row_w, m->area, m->triangles, m->x, m->x0, m->pseudo_normal,
+                 m->face_normal, m->weld, m->edge_other);
     sem_bvh_free(&m->bvh);
     memset(m, 0, sizeof *m);
 }
@@ -348,11 +334,7 @@ done:
     if (st != SEM_OK) sem_collision_mesh_free(out);
     sem_mesh_free(&mesh);
     sem_mesh_template_destroy(tmpl);
-    free(index);
-    free(phi);
-    free(used);
-    free(q);
-    free(part_offset);
+    SEM_FREE_ALL(index, phi, used, q, part_offset);
     return st;
 }
 

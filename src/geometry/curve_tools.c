@@ -4,6 +4,7 @@
  * (a ruled surface's rails). Piegl & Tiller, The NURBS Book, A5.1 and section 5.5.
  */
 #include "curve_tools.h"
+#include "util/free_all.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -59,22 +60,14 @@ sem_status sem_curve_insert_knot(sem_curve *c, double t, int times)
     for (int i = L + 1; i < k - s; ++i) memcpy(Qw + 4 * i, Rw + 4 * (i - L), 4 * sizeof(double));
     double *ctrl = malloc((size_t)nq * 3 * sizeof *ctrl), *w = malloc((size_t)nq * sizeof *w);
     if (!ctrl || !w) {
-        free(ctrl);
-        free(w);
-        free(UQ);
-        free(Qw);
-        free(Pw);
+        SEM_FREE_ALL(ctrl, w, UQ, Qw, Pw);
         return SEM_ERR_NOMEM;
     }
     for (int i = 0; i < nq; ++i) {
         w[i] = Qw[4 * i + 3];
         for (int d = 0; d < 3; ++d) ctrl[3 * i + d] = Qw[4 * i + d] / w[i];
     }
-    free(c->knots);
-    free(c->ctrl);
-    free(c->weights);
-    free(Qw);
-    free(Pw);
+    SEM_FREE_ALL(c->knots, c->ctrl, c->weights, Qw, Pw);
     c->knots = UQ;
     c->ctrl = ctrl;
     c->weights = w;

@@ -27,6 +27,7 @@
 
 #include "sem/nurbs.h"
 #include "sem/trim.h"
+#include "util/free_all.h"
 
 #define MAX_GAUSS 24
 #define LEAF_DIVISIONS 64.0 /* trimmed leaves: this many per domain width */
@@ -479,10 +480,7 @@ static sem_status part_bbox(const sem_part *part, const sem_trim_region *region,
     double *tu_edge = sample_line(bu, nbu, 4 * mu, &nu_edge);
     double *tv_edge = sample_line(bv, nbv, 4 * mv, &nv_edge);
     if (!tu || !tv || !tu_edge || !tv_edge) {
-        free(tu);
-        free(tv);
-        free(tu_edge);
-        free(tv_edge);
+        SEM_FREE_ALL(tu, tv, tu_edge, tv_edge);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory measuring a part");
     }
     for (int j = 0; j < nv; ++j)
@@ -529,10 +527,7 @@ static sem_status part_bbox(const sem_part *part, const sem_trim_region *region,
         for (int k = 0; k < x->n; ++k)
             compass_search(&c, e / 2, (e % 2) ? 1.0 : -1.0, x->u[k], x->v[k], hu, hv);
     }
-    free(tu);
-    free(tv);
-    free(tu_edge);
-    free(tv_edge);
+    SEM_FREE_ALL(tu, tv, tu_edge, tv_edge);
     for (int d = 0; d < 3; ++d) {
         out->bbox_min[d] = c.lo[d];
         out->bbox_max[d] = c.hi[d];

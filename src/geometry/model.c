@@ -1,6 +1,7 @@
 /* model.c - life cycle and bookkeeping of NURBS models (see sem/model.h). */
 #include "sem/model.h"
 #include "sem/limits.h"
+#include "util/free_all.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -37,10 +38,7 @@ void sem_curve_free(sem_curve *c)
 void sem_surface_free(sem_surface *s)
 {
     if (!s) return;
-    free(s->knots_u);
-    free(s->knots_v);
-    free(s->ctrl);
-    free(s->weights);
+    SEM_FREE_ALL(s->knots_u, s->knots_v, s->ctrl, s->weights);
     memset(s, 0, sizeof *s);
 }
 

@@ -29,6 +29,7 @@
 
 #include "sem/limits.h"
 #include "sem/nurbs.h"
+#include "util/free_all.h"
 
 /* Rows of homogeneous points along one direction: row r's point i at H + 4 (r n + i). */
 typedef struct family {
@@ -225,10 +226,6 @@ sem_status sem_surface_move_seam(sem_surface *s, int dir, double start, sem_erro
         }
         U = ctrl = weights = NULL;
     }
-    free(U);
-    free(ctrl);
-    free(weights);
-    free(f.U);
-    free(f.H);
+    SEM_FREE_ALL(U, ctrl, weights, f.U, f.H);
     return st;
 }

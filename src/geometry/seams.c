@@ -35,6 +35,8 @@
 #include "sem/measure.h"
 #include "sem/nurbs.h"
 #include "sem/trim.h"
+#include "util/free_all.h"
+#include "util/grow.h"
 
 /* Boundary points about this far apart, relative to the model size. */
 #define SPACING 0.01
@@ -52,12 +54,9 @@ static int point_push(point_list *l, const double uv[2], const double X[3])
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
-        double *a = realloc(l->uv, (size_t)cap * 2 * sizeof(double));
-        if (!a) return -1;
-        l->uv = a;
-        double *b = realloc(l->X, (size_t)cap * 3 * sizeof(double));
-        if (!b) return -1;
-        l->X = b;
+        if (!sem_resize((void **)&l->uv, (size_t)cap * 2, sizeof(double)) ||
+            !sem_resize((void **)&l->X, (size_t)cap * 3, sizeof(double)))
+            return -1;
         l->cap = cap;
     }
     memcpy(l->uv + 2 * (size_t)l->n, uv, 2 * sizeof(double));
@@ -167,15 +166,10 @@ static int pair_push(pair_list *l, int a, const double uva[2], int b, const doub
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
-        int *p = realloc(l->part, (size_t)cap * 2 * sizeof(int));
-        if (!p) return -1;
-        l->part = p;
-        double *u = realloc(l->uv, (size_t)cap * 4 * sizeof(double));
-        if (!u) return -1;
-        l->uv = u;
-        double *r = realloc(l->rest, (size_t)cap * sizeof(double));
-        if (!r) return -1;
-        l->rest = r;
+        if (!sem_resize((void **)&l->part, (size_t)cap * 2, sizeof(int)) ||
+            !sem_resize((void **)&l->uv, (size_t)cap * 4, sizeof(double)) ||
+            !sem_resize((void **)&l->rest, (size_t)cap, sizeof(double)))
+            return -1;
         l->cap = cap;
     }
     l->part[2 * l->n] = a;
@@ -224,11 +218,7 @@ static int partner(const sem_surface_sampler *sampler, const sem_trim_region *re
 void sem_seams_free(sem_seams *s)
 {
     if (!s) return;
-    free(s->part);
-    free(s->row_start);
-    free(s->row_ctrl);
-    free(s->row_w);
-    free(s->rest_distance);
+    SEM_FREE_ALL(s->part, s->row_start, s->row_ctrl, s->row_w, s->rest_distance);
     memset(s, 0, sizeof *s);
 }
 
@@ -376,12 +366,7 @@ done:
     for (int p = 0; samplers && p < np; ++p) sem_surface_sampler_free(&samplers[p]);
     for (int p = 0; boundary && p < np; ++p) point_list_free(&boundary[p]);
     for (int p = 0; pairs && p < np; ++p) pair_list_free(&pairs[p]);
-    free(regions);
-    free(samplers);
-    free(boundary);
-    free(pairs);
-    free(box);
-    free(offset);
+    SEM_FREE_ALL(regions, samplers, boundary, pairs, box, offset);
     return st;
 }
 

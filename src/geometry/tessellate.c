@@ -19,6 +19,7 @@
 
 #include "sem/nurbs.h"
 #include "sem/trim.h"
+#include "util/free_all.h"
 
 typedef struct part_template {
     int first_vertex, n_vertices;
@@ -43,15 +44,8 @@ struct sem_mesh_template {
 void sem_mesh_template_destroy(sem_mesh_template *t)
 {
     if (!t) return;
-    free(t->parts);
-    free(t->uv);
-    free(t->vertex_part);
-    free(t->triangles);
-    free(t->triangle_part);
-    free(t->basis_index);
-    free(t->phi);
-    free(t->phi_u);
-    free(t->phi_v);
+    SEM_FREE_ALL(t->parts, t->uv, t->vertex_part, t->triangles, t->triangle_part, t->basis_index, t->phi, t->phi_u,
+                 t->phi_v);
     free(t);
 }
 
@@ -96,11 +90,7 @@ typedef struct part_topology {
 
 static void part_topology_free(part_topology *pt)
 {
-    free(pt->us);
-    free(pt->vs);
-    free(pt->node);
-    free(pt->triangles);
-    free(pt->vertex_node);
+    SEM_FREE_ALL(pt->us, pt->vs, pt->node, pt->triangles, pt->vertex_node);
     memset(pt, 0, sizeof *pt);
 }
 
@@ -474,13 +464,8 @@ sem_status sem_mesh_template_build_covering(const sem_model *model, int resoluti
 void sem_mesh_free(sem_mesh *m)
 {
     if (!m) return;
-    free(m->positions);
-    free(m->normals);
-    free(m->uv);
-    free(m->triangles);
-    free(m->triangle_part);
-    free(m->part_vertex_start);
-    free(m->part_triangle_start);
+    SEM_FREE_ALL(m->positions, m->normals, m->uv, m->triangles, m->triangle_part, m->part_vertex_start,
+                 m->part_triangle_start);
     memset(m, 0, sizeof *m);
 }
 

@@ -4,6 +4,7 @@
  */
 #include "contact_world.h"
 
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -14,6 +15,8 @@
 #include "contact/friction.h"
 #include "contact/penalty.h"
 #include "geometry/vector3.h"
+#include "util/free_all.h"
+#include "util/grow.h"
 #include "util/union_find.h"
 
 /* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
@@ -121,11 +124,7 @@ sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem
 
 static void collider_free(collider *k)
 {
-    free(k->vertices);
-    free(k->triangles);
-    free(k->face_normal);
-    free(k->edge_normal);
-    free(k->vertex_normal);
+    SEM_FREE_ALL(k->vertices, k->triangles, k->face_normal, k->edge_normal, k->vertex_normal);
     sem_bvh_free(&k->bvh);
 }
 
@@ -134,15 +133,8 @@ void sem_contact_destroy(sem_contact *c)
     if (!c) return;
     for (int i = 0; i < c->n_colliders; ++i) collider_free(&c->colliders[i]);
     for (int i = 0; i < c->n_objects; ++i) sem_collision_mesh_free(&c->objects[i].mesh);
-    free(c->colliders);
-    free(c->objects);
-    free(c->recs);
-    free(c->slots);
-    free(c->slot_count);
-    free(c->sys_to_contact);
-    free(c->friction);
-    free(c->fweights);
-    free(c->couplings);
+    SEM_FREE_ALL(c->colliders, c->objects, c->recs, c->slots, c->slot_count, c->sys_to_contact, c->friction,
+                 c->fweights, c->couplings);
     sem_point_terms_free(&c->terms);
     sem_point_terms_free(&c->friction_terms);
     free(c);
@@ -261,15 +253,9 @@ sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def,
         }
     } else
         return sem_error_set(err, SEM_ERR_INVALID, "unknown collider type %d", (int)def->type);
-    if (c->n_colliders == c->cap_colliders) {
-        int cap = c->cap_colliders ? 2 * c->cap_colliders : 4;
-        collider *x = realloc(c->colliders, (size_t)cap * sizeof *x);
-        if (!x) {
-            collider_free(&k);
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        }
-        c->colliders = x;
-        c->cap_colliders = cap;
+    if (!sem_grow((void **)&c->colliders, &c->cap_colliders, c->n_colliders + 1, sizeof *c->colliders, 4, INT_MAX)) {
+        collider_free(&k);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     c->colliders[c->n_colliders++] = k;
     c->stats.colliders = c->n_colliders;
@@ -278,13 +264,8 @@ sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def,
 
 sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error *err)
 {
-    if (c->n_objects == c->cap_objects) {
-        int cap = c->cap_objects ? 2 * c->cap_objects : 4;
-        contact_object *x = realloc(c->objects, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        c->objects = x;
-        c->cap_objects = cap;
-    }
+    if (!sem_grow((void **)&c->objects, &c->cap_objects, c->n_objects + 1, sizeof *c->objects, 4, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     contact_object *co = &c->objects[c->n_objects];
     memset(co, 0, sizeof *co);
     co->object = o;
@@ -372,13 +353,8 @@ static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err
 
 static sem_status push_rec(sem_contact *c, const contact_rec *r, sem_error *err)
 {
-    if (c->n_recs == c->cap_recs) {
-        int cap = c->cap_recs ? 2 * c->cap_recs : 256;
-        contact_rec *x = realloc(c->recs, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
-        c->recs = x;
-        c->cap_recs = cap;
-    }
+    if (!sem_grow((void **)&c->recs, &c->cap_recs, c->n_recs + 1, sizeof *c->recs, 256, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
     c->recs[c->n_recs++] = *r;
     return SEM_OK;
 }
@@ -708,13 +684,8 @@ static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_erro
         for (int j = 0; j < c->n_couplings && !seen; ++j)
             seen = !memcmp(&c->couplings[j], &cp, sizeof cp);
         if (seen) continue;
-        if (c->n_couplings == c->cap_couplings) {
-            int cap = c->cap_couplings ? 2 * c->cap_couplings : 64;
-            sem_system_coupling *x = realloc(c->couplings, (size_t)cap * sizeof *x);
-            if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-            c->couplings = x;
-            c->cap_couplings = cap;
-        }
+        if (!sem_grow((void **)&c->couplings, &c->cap_couplings, c->n_couplings + 1, sizeof *c->couplings, 64, INT_MAX))
+            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         c->couplings[c->n_couplings++] = cp;
     }
     return SEM_OK;
@@ -772,26 +743,11 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         double lambda = r->stiffness * (r->thickness - r->d);
         if (!(r->mu > 0) || !(lambda > 0)) continue;
         int n = rec_weights(c, r, w);
-        if (c->n_friction == c->cap_friction) {
-            int cap = c->cap_friction ? 2 * c->cap_friction : 256;
-            friction_rec *x = realloc(c->friction, (size_t)cap * sizeof *x);
-            if (!x) {
-                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
-                break;
-            }
-            c->friction = x;
-            c->cap_friction = cap;
-        }
-        if (c->n_fweights + n > c->cap_fweights) {
-            int cap = c->cap_fweights ? 2 * c->cap_fweights : 4096;
-            while (cap < c->n_fweights + n) cap *= 2;
-            sem_point_weight *x = realloc(c->fweights, (size_t)cap * sizeof *x);
-            if (!x) {
-                st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
-                break;
-            }
-            c->fweights = x;
-            c->cap_fweights = cap;
+        if (!sem_grow((void **)&c->friction, &c->cap_friction, c->n_friction + 1, sizeof *c->friction, 256, INT_MAX) ||
+            !sem_grow((void **)&c->fweights, &c->cap_fweights, c->n_fweights + n, sizeof *c->fweights, 4096,
+                      INT_MAX)) {
+            st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for friction");
+            break;
         }
         friction_rec *fr = &c->friction[c->n_friction++];
         fr->first = c->n_fweights;
@@ -848,10 +804,7 @@ sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, doubl
     }
     for (size_t i = 0; i < s->n_dofs; ++i) rhs[i] -= h * g[i];
 done:
-    free(q);
-    free(qpred);
-    free(v);
-    free(g);
+    SEM_FREE_ALL(q, qpred, v, g);
     c->stats.seconds += omp_get_wtime() - t0;
     return st;
 }

@@ -14,6 +14,7 @@
 #include "loads.h"
 #include "pins.h"
 #include "runaway.h"
+#include "util/free_all.h"
 
 /*
  * Reusing the rest factor. The step's matrix is A = R + h^2 (K(q_n) - K0) with the rest matrix
@@ -285,11 +286,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         }
         sem_system_scatter_free(s, fr, vp);
     }
-    for (size_t i = 0; i < n; ++i)
-        if (!isfinite(vp[i])) {
-            st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
-            goto done;
-        }
+    if ((st = sem_runaway_check_finite(vp, n, t1, err)) != SEM_OK) goto done;
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t no = 3 * (size_t)o->n_ctrl;
@@ -297,14 +294,7 @@ static sem_status step_linearly_implicit(sem_world *w, sem_system *s, sem_error 
         for (size_t i = 0; i < no; ++i) o->q[i] += h * o->v[i];
     }
 done:
-    free(f);
-    free(g);
-    free(rhs);
-    free(tmp);
-    free(vp);
-    free(fr);
-    free(xr);
-    free(work);
+    SEM_FREE_ALL(f, g, rhs, tmp, vp, fr, xr, work);
     return st;
 }
 

@@ -1,5 +1,6 @@
 /* linear_solver.c - CHOLMOD and dense LAPACK Cholesky behind one interface (see header). */
 #include "linear_solver.h"
+#include "util/free_all.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -192,11 +193,7 @@ void sem_linear_solver_destroy(sem_linear_solver *s)
     if (s->L) cholmod_free_factor(&s->L, &s->common);
     if (s->A) cholmod_free_sparse(&s->A, &s->common);
     cholmod_finish(&s->common);
-    free(s->dense);
-    free(s->perm);
-    free(s->remap);
-    free(s->work);
-    free(s->partial);
+    SEM_FREE_ALL(s->dense, s->perm, s->remap, s->work, s->partial);
     free(s);
 }
 

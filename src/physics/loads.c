@@ -8,21 +8,25 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A copy of size bytes at data, or NULL when out of memory. */
+static void *copy_of(const void *data, size_t size)
+{
+    void *copy = malloc(size);
+    if (copy) memcpy(copy, data, size);
+    return copy;
+}
+
 sem_status sem_loads_init(sem_object *o, const sem_object_def *def, sem_error *err)
 {
     /* the object keeps copies: the caller's arrays need not outlive sem_world_add_object */
     if (def->n_point_loads > 0) {
-        sem_point_load *pl = malloc((size_t)def->n_point_loads * sizeof *pl);
-        if (!pl) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        memcpy(pl, def->point_loads, (size_t)def->n_point_loads * sizeof *pl);
-        o->def.point_loads = pl;
+        o->def.point_loads = copy_of(def->point_loads, (size_t)def->n_point_loads * sizeof *def->point_loads);
+        if (!o->def.point_loads) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         o->def.n_point_loads = def->n_point_loads;
     }
     if (def->n_region_loads > 0) {
-        sem_region_load *rl = malloc((size_t)def->n_region_loads * sizeof *rl);
-        if (!rl) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        memcpy(rl, def->region_loads, (size_t)def->n_region_loads * sizeof *rl);
-        o->def.region_loads = rl;
+        o->def.region_loads = copy_of(def->region_loads, (size_t)def->n_region_loads * sizeof *def->region_loads);
+        if (!o->def.region_loads) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         o->def.n_region_loads = def->n_region_loads;
     }
     o->pinned = calloc((size_t)o->n_ctrl + 1, 1);

@@ -15,6 +15,7 @@
  * the same on every run.
  */
 #include "lowest_modes.h"
+#include "util/free_all.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -149,13 +150,6 @@ int sem_lowest_modes(const sem_mode_operator *op, size_t n, int block, int want,
     if (vectors) memcpy(vectors, X, (size_t)want * n * sizeof *vectors);
     rc = converged ? 0 : 1;
 done:
-    free(X);
-    free(MX);
-    free(R);
-    free(MR);
-    free(KY);
-    free(H);
-    free(w);
-    free(prev);
+    SEM_FREE_ALL(X, MX, R, MR, KY, H, w, prev);
     return rc;
 }

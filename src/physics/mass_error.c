@@ -7,6 +7,7 @@
 #include "assembly.h"
 #include "pins.h"
 #include "structured.h"
+#include "util/free_all.h"
 
 #include <cblas.h>
 #include <limits.h>
@@ -268,21 +269,14 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
             st = sem_structured_init(o, Mz, Bz, Az, n_ties, tie_ctrl, tie_part, tie_weight,
                                      SEM_WELD_STIFFNESS * tie_weight, err);
         o->n_orphans = n_ties;
-        free(tie_ctrl);
-        free(tie_part);
-        free(Mz);
-        free(Bz);
-        free(Az);
+        SEM_FREE_ALL(tie_ctrl, tie_part, Mz, Bz, Az);
         return st;
     }
     size_t mg = sem_max_group_size(o);
     double *tmp = malloc((size_t)m * mg * sizeof(double));
     if (Az) o->A_blocks = calloc(o->gpair_offset[o->n_gpairs] + 1, sizeof(double));
     if (!tmp || (Az && !o->A_blocks)) {
-        free(tmp);
-        free(Mz);
-        free(Bz);
-        free(Az);
+        SEM_FREE_ALL(tmp, Mz, Bz, Az);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int k = 0; k < np; ++k) {
@@ -296,10 +290,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
             add_projected(o, o->pair_a[k], o->pair_b[k], Az + (size_t)k * m * m, m,
                           o->A_blocks + o->gpair_offset[g], tmp);
     }
-    free(tmp);
-    free(Mz);
-    free(Bz);
-    free(Az);
+    SEM_FREE_ALL(tmp, Mz, Bz, Az);
     /* the orphan control points' ties (find_orphans) */
     {
         int *tie_ctrl = NULL, *tie_part = NULL, n_ties = 0;
@@ -435,10 +426,7 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                 }
             }
         }
-        free(rows);
-        free(rc);
-        free(rv);
-        free(slot);
+        SEM_FREE_ALL(rows, rc, rv, slot);
         if (st != SEM_OK) return st;
     }
     return SEM_OK;

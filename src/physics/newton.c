@@ -18,6 +18,8 @@
 #include "loads.h"
 #include "pins.h"
 #include "point_terms.h"
+#include "runaway.h"
+#include "util/free_all.h"
 
 /* Newton stops as converged after NEWTON_STALL_ITERATIONS full steps in a row, each moving no
  * coordinate by more than NEWTON_STALL_MOVE of the largest coordinate, without halving the
@@ -343,11 +345,7 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             w->def.log(w->def.log_user, 1, line);
         }
     }
-    for (size_t i = 0; i < n; ++i)
-        if (!isfinite(q[i])) {
-            st = sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t1);
-            goto done;
-        }
+    if ((st = sem_runaway_check_finite(q, n, t1, err)) != SEM_OK) goto done;
     for (int k = 0; k < s->n_objects; ++k) {
         sem_object *o = s->objects[k];
         size_t off = s->dof_offset[k], no = 3 * (size_t)o->n_ctrl;
@@ -362,17 +360,6 @@ done:
     if (gathered)
         for (int k = 0; k < s->n_objects; ++k)
             memcpy(s->objects[k]->q, q + s->dof_offset[k], 3 * (size_t)s->objects[k]->n_ctrl * sizeof(double));
-    free(q);
-    free(qn);
-    free(qpred);
-    free(f);
-    free(g);
-    free(tmp);
-    free(dq);
-    free(qtry);
-    free(dir);
-    free(gq);
-    free(adir);
-    free(fr);
+    SEM_FREE_ALL(q, qn, qpred, f, g, tmp, dq, qtry, dir, gq, adir, fr);
     return st;
 }

@@ -35,6 +35,7 @@
 
 #include "assembly.h"
 #include "lowest_modes.h"
+#include "util/free_all.h"
 
 enum { MODES_WANT = 8, MODES_BLOCK = 12, MODES_MAX_ITER = 80 };
 
@@ -162,14 +163,6 @@ sem_status sem_world_object_modes(sem_world *w, int object, sem_object_modes *ou
     }
 done:
     sem_system_destroy(s);
-    free(tmp.free_index);
-    free(tmp.pinned);
-    free(R);
-    free(vals);
-    free(vec);
-    free(Mv);
-    free(share);
-    free(c.fa);
-    free(c.fb);
+    SEM_FREE_ALL(tmp.free_index, tmp.pinned, R, vals, vec, Mv, share, c.fa, c.fb);
     return st;
 }

@@ -12,6 +12,7 @@
 
 #include "loads.h"
 #include "shared_kernels.h"
+#include "util/free_all.h"
 
 static int in_box(const double box[6], const double X[3])
 {
@@ -23,15 +24,7 @@ void sem_pins_free(sem_object *o)
 {
     sem_pins *p = o->pins;
     if (!p) return;
-    free(p->weight);
-    free(p->X);
-    free(p->presc);
-    free(p->start);
-    free(p->part);
-    free(p->basis);
-    free(p->prescribes);
-    free(p->touched);
-    free(p->touched_slot);
+    SEM_FREE_ALL(p->weight, p->X, p->presc, p->start, p->part, p->basis, p->prescribes, p->touched, p->touched_slot);
     free(p);
     o->pins = NULL;
 }
@@ -266,12 +259,7 @@ void sem_pins_held_parts(const sem_object *o, const sem_object_def *def)
         p->held_outside = share;
     }
 done:
-    free(all);
-    free(held);
-    free(total);
-    free(outside);
-    free(lo);
-    free(hi);
+    SEM_FREE_ALL(all, held, total, outside, lo, hi);
 }
 
 void sem_pins_add_pair_blocks(const sem_object *o, double *pairs)

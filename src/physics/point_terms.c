@@ -6,8 +6,11 @@
  */
 #include "point_terms.h"
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "util/grow.h"
 
 void sem_point_terms_init(sem_point_terms *t) { memset(t, 0, sizeof *t); }
 
@@ -27,21 +30,9 @@ void sem_point_terms_clear(sem_point_terms *t)
 sem_status sem_point_terms_push(sem_point_terms *t, const sem_point_weight *weights, int count,
                                 const double H[9], sem_error *err)
 {
-    if (t->n == t->cap) {
-        int cap = t->cap ? 2 * t->cap : 256;
-        sem_point_term *x = realloc(t->terms, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contact terms");
-        t->terms = x;
-        t->cap = cap;
-    }
-    if (t->n_weights + count > t->cap_weights) {
-        int cap = t->cap_weights ? 2 * t->cap_weights : 4096;
-        while (cap < t->n_weights + count) cap *= 2;
-        sem_point_weight *x = realloc(t->weights, (size_t)cap * sizeof *x);
-        if (!x) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contact terms");
-        t->weights = x;
-        t->cap_weights = cap;
-    }
+    if (!sem_grow((void **)&t->terms, &t->cap, t->n + 1, sizeof *t->terms, 256, INT_MAX) ||
+        !sem_grow((void **)&t->weights, &t->cap_weights, t->n_weights + count, sizeof *t->weights, 4096, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contact terms");
     sem_point_term *term = &t->terms[t->n++];
     term->first = t->n_weights;
     term->count = count;

@@ -115,3 +115,10 @@ sem_status sem_runaway_check(sem_object *o, int is_static, double t, sem_error *
     free(f);
     return st;
 }
+
+sem_status sem_runaway_check_finite(const double *x, size_t n, double t, sem_error *err)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return sem_error_set(err, SEM_ERR_NUMERIC, "the state became non-finite (NaN) at t = %g", t);
+    return SEM_OK;
+}

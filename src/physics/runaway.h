@@ -12,5 +12,8 @@ sem_status sem_runaway_init(sem_object *o, const double gravity[3], sem_error *e
  * mechanical energy exceeds by orders of magnitude what its inputs can supply, or its state
  * is not finite (is_static: also far below, see runaway.c). */
 sem_status sem_runaway_check(sem_object *o, int is_static, double t, sem_error *err);
+/* After a step to time t: SEM_ERR_NUMERIC with a one-line message when any of x[0..n-1] (the
+ * system's new positions or velocities) is not finite. */
+sem_status sem_runaway_check_finite(const double *x, size_t n, double t, sem_error *err);
 
 #endif

@@ -17,27 +17,14 @@
 #include <string.h>
 
 #include "shared_kernels.h"
+#include "util/free_all.h"
 
 void sem_structured_free(sem_object *o)
 {
     sem_structured_ops *s = o->ops;
     if (!s) return;
-    free(s->p_start);
-    free(s->p_col);
-    free(s->p_val);
-    free(s->area);
-    free(s->j_start);
-    free(s->j_col);
-    free(s->j_val);
-    free(s->g_start);
-    free(s->g_idx);
-    free(s->g_val);
-    free(s->nb_start);
-    free(s->nb_part);
-    free(s->Mz);
-    free(s->Bb);
-    free(s->Bz);
-    free(s->Az);
+    SEM_FREE_ALL(s->p_start, s->p_col, s->p_val, s->area, s->j_start, s->j_col, s->j_val, s->g_start, s->g_idx,
+                 s->g_val, s->nb_start, s->nb_part, s->Mz, s->Bb, s->Bz, s->Az);
     free(s);
     o->ops = NULL;
 }

@@ -46,6 +46,7 @@
 #include "structured.h"
 
 #include "sem/limits.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 #include <cblas.h>
@@ -112,31 +113,11 @@ void sem_structured_solver_destroy(sem_structured_solver *s)
     if (!s) return;
     if (s->L) cholmod_free_factor(&s->L, &s->common);
     cholmod_finish(&s->common);
-    free(s->red);
-    free(s->p_first);
-    free(s->v_start);
-    free(s->v_col);
-    free(s->v_val);
-    free(s->vt_start);
-    free(s->vt_row);
-    free(s->vt_val);
-    free(s->F);
-    free(s->T);
-    free(s->Ep);
-    free(s->Bp);
-    free(s->Hc);
-    free(s->C);
-    free(s->C_rest);
-    free(s->H);
-    free(s->Zt);
+    SEM_FREE_ALL(s->red, s->p_first, s->v_start, s->v_col, s->v_val, s->vt_start, s->vt_row, s->vt_val, s->F, s->T,
+                 s->Ep, s->Bp, s->Hc, s->C, s->C_rest, s->H, s->Zt);
     if (s->Ep_blk)
         for (int g = 0; g < s->n_groups; ++g) free(s->Ep_blk[g]);
-    free(s->Ep_blk);
-    free(s->grow);
-    free(s->grow_list);
-    free(s->gcol);
-    free(s->gscratch);
-    free(s->work);
+    SEM_FREE_ALL(s->Ep_blk, s->grow, s->grow_list, s->gcol, s->gscratch, s->work);
     free(s);
 }
 
@@ -233,11 +214,7 @@ static sem_status build_V(sem_structured_solver *s, sem_error *err)
     int *fill = malloc(((size_t)r0 + 1) * sizeof(int));
     int *row_n = calloc(2 * (size_t)r0 + 1, sizeof(int));
     if (!gt_row || !gt_val || !fill || !row_n) {
-        free(gt_start);
-        free(gt_row);
-        free(gt_val);
-        free(fill);
-        free(row_n);
+        SEM_FREE_ALL(gt_start, gt_row, gt_val, fill, row_n);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     memcpy(fill, gt_start, (size_t)r0 * sizeof(int));
@@ -362,12 +339,7 @@ done:
         for (int r = 0; r < r0; ++r) free(G_vals[r]);
     if (G_cols)
         for (int r = 0; r < r0; ++r) free(G_cols[r]);
-    free(G_vals);
-    free(G_cols);
-    free(gt_start);
-    free(gt_row);
-    free(gt_val);
-    free(row_n);
+    SEM_FREE_ALL(G_vals, G_cols, gt_start, gt_row, gt_val, row_n);
     return st;
 }
 
@@ -483,10 +455,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     }
     int ng = blocks_of(o, block);
     if (ng < 0) {
-        free(U);
-        free(lam);
-        free(dsq);
-        free(block);
+        SEM_FREE_ALL(U, lam, dsq, block);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     s->n_groups = ng;
@@ -495,10 +464,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     s->gcol = calloc((size_t)ng + 1, sizeof(int));
     s->Ep_blk = calloc((size_t)ng + 1, sizeof(double *));
     if (!s->grow || !s->grow_list || !s->gcol || !s->Ep_blk) {
-        free(U);
-        free(lam);
-        free(dsq);
-        free(block);
+        SEM_FREE_ALL(U, lam, dsq, block);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int q = 0; q < r; ++q) s->grow[block[o->d->part_origin[s->p_first[q] / m]] + 1]++;
@@ -506,10 +472,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     {
         int *fill = malloc(((size_t)ng + 1) * sizeof(int));
         if (!fill) {
-            free(U);
-            free(lam);
-            free(dsq);
-            free(block);
+            SEM_FREE_ALL(U, lam, dsq, block);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
         memcpy(fill, s->grow, (size_t)ng * sizeof(int));
@@ -522,12 +485,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     double *Ucol = calloc(rr + 1, sizeof(double)), *lcol = malloc((size_t)r * sizeof(double) + 1);
     int *col_row_group = malloc((size_t)r * sizeof(int) + 1);
     if (!Ucol || !lcol || !col_row_group) {
-        free(U);
-        free(lam);
-        free(dsq);
-        free(Ucol);
-        free(lcol);
-        free(col_row_group);
+        SEM_FREE_ALL(U, lam, dsq, Ucol, lcol, col_row_group);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     int k = 0;
@@ -558,11 +516,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     (void)col_row_group;
     free(col_row_group);
     if (info != 0) {
-        free(U);
-        free(lam);
-        free(dsq);
-        free(Ucol);
-        free(lcol);
+        SEM_FREE_ALL(U, lam, dsq, Ucol, lcol);
         return sem_error_set(err, SEM_ERR_NUMERIC, "structured solver: eigenvalues of F1 failed (%d)", (int)info);
     }
     s->k = k;
@@ -572,12 +526,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
     s->Hc = malloc(((size_t)k * k + 1) * sizeof(double));
     double *X = malloc(((size_t)r * k + 1) * sizeof(double));
     if (!s->T || !s->Ep || !s->Bp || !s->Hc || !X) {
-        free(U);
-        free(lam);
-        free(X);
-        free(dsq);
-        free(Ucol);
-        free(lcol);
+        SEM_FREE_ALL(U, lam, X, dsq, Ucol, lcol);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int a = 0; a < r; ++a)
@@ -593,10 +542,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
         int r0g = s->grow[g], rg = s->grow[g + 1] - r0g, c0 = s->gcol[g], kg = s->gcol[g + 1] - c0;
         s->Ep_blk[g] = malloc(((size_t)rg * kg + 1) * sizeof(double));
         if (!s->Ep_blk[g]) {
-            free(U);
-            free(lam);
-            free(X);
-            free(dsq);
+            SEM_FREE_ALL(U, lam, X, dsq);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
         }
         for (int a = 0; a < rg; ++a)
@@ -617,10 +563,7 @@ static sem_status schur_constants(sem_structured_solver *s, sem_error *err)
             double v = 0.5 * (s->Hc[(size_t)a * k + b] + s->Hc[(size_t)b * k + a]);
             s->Hc[(size_t)a * k + b] = s->Hc[(size_t)b * k + a] = v;
         }
-    free(U);
-    free(lam);
-    free(X);
-    free(dsq);
+    SEM_FREE_ALL(U, lam, X, dsq);
     return SEM_OK;
 }
 

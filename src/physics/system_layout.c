@@ -5,6 +5,7 @@
 #include "system.h"
 
 #include "structured.h"
+#include "util/free_all.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -189,12 +190,7 @@ static sem_status build_pattern(sem_system *s, sem_solver_choice choice, sem_err
         for (int i = 0; i < s->n_couplings; ++i)
             sem_linear_solver_remap(s->solver, s->coupling_map[i], coupling_entries(s, i));
 done:
-    free(sorted);
-    free(perm);
-    free(inv);
-    free(rows);
-    free(fill);
-    free(count);
+    SEM_FREE_ALL(sorted, perm, inv, rows, fill, count);
     return st;
 }
 

@@ -30,6 +30,7 @@
 #include "system.h"
 #include "sem/limits.h"
 #include "structured.h"
+#include "util/free_all.h"
 
 sem_world_def sem_default_world_def(void)
 {
@@ -87,71 +88,22 @@ sem_world *sem_world_create(const sem_world_def *def, sem_error *err)
 static void object_destroy(sem_object *o)
 {
     if (!o) return;
-    free(o->q);
-    free(o->v);
-    free(o->q0);
-    free(o->point_material);
-    free(o->point_rho_vol);
-    free(o->entry_basis);
-    free(o->entry_pair_offset);
-    free(o->part_mats);
-    free(o->point_pairs);
-    free(o->pair_a);
-    free(o->pair_b);
-    free(o->pair_lookup);
-    free(o->group_start);
-    free(o->group_ctrl);
-    free(o->ctrl_group);
-    free(o->ctrl_local);
-    free(o->part_tied);
     if (o->pi_dense)
         for (int i = 0; i < o->n_parts; ++i) free(o->pi_dense[i]);
-    free(o->pi_dense);
     if (o->pi_shared)
         for (int i = 0; i < o->n_parts; ++i) free(o->pi_shared[i]);
-    free(o->pi_shared);
-    free(o->point_D);
-    free(o->plist_start);
-    free(o->plist_point);
-    free(o->plist_w);
-    free(o->plist_cursor);
-    free(o->N_chunk);
-    free(o->Kz_packed);
-    free(o->gpair_a);
-    free(o->gpair_b);
-    free(o->gpair_lookup);
-    free(o->gpair_offset);
-    free(o->part_pair_gpair);
-    free(o->gpair_pairs_start);
-    free(o->gpair_pairs);
-    free(o->K_blocks);
-    free(o->M_blocks);
-    free(o->E_blocks);
-    free(o->me_start);
-    free(o->me_col);
-    free(o->me_M);
-    free(o->me_E);
-    free(o->K0_blocks);
-    free(o->A_blocks);
     sem_pins_free(o);
-    free(o->K0z);
-    free(o->point_H);
-    free(o->point_H0);
     sem_structured_free(o);
-    free(o->f_gravity);
-    free(o->pinned);
-    free(o->presc_index);
-    free(o->presc);
-    free(o->free_index);
-    free(o->z);
-    free(o->grad_z);
-    free(o->Kz);
-    free(o->qc);
     sem_seams_free(&o->seams);
-    free(o->weld_ctrl);
-    free(o->grad_z_share);
-    free((void *)o->def.point_loads);
-    free((void *)o->def.region_loads);
+    SEM_FREE_ALL(o->q, o->v, o->q0, o->point_material, o->point_rho_vol, o->entry_basis, o->entry_pair_offset,
+                 o->part_mats, o->point_pairs, o->pair_a, o->pair_b, o->pair_lookup, o->group_start, o->group_ctrl,
+                 o->ctrl_group, o->ctrl_local, o->part_tied, o->pi_dense, o->pi_shared, o->point_D, o->plist_start,
+                 o->plist_point, o->plist_w, o->plist_cursor, o->N_chunk, o->Kz_packed, o->gpair_a, o->gpair_b,
+                 o->gpair_lookup, o->gpair_offset, o->part_pair_gpair, o->gpair_pairs_start, o->gpair_pairs,
+                 o->K_blocks, o->M_blocks, o->E_blocks, o->me_start, o->me_col, o->me_M, o->me_E, o->K0_blocks,
+                 o->A_blocks, o->K0z, o->point_H, o->point_H0, o->f_gravity, o->pinned, o->presc_index, o->presc,
+                 o->free_index, o->z, o->grad_z, o->Kz, o->qc, o->weld_ctrl, o->grad_z_share,
+                 (void *)o->def.point_loads, (void *)o->def.region_loads);
     free(o);
 }
 

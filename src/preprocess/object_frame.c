@@ -274,17 +274,9 @@ static int double_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-sem_status sem_part_sizes(const sem_discretization *d, double *size, double *median)
+void sem_part_frame_boxes(const sem_discretization *d, double *box)
 {
-    int np = d->n_parts;
-    double *box = malloc(6 * (size_t)(np > 0 ? np : 1) * sizeof *box);
-    double *sorted = malloc((size_t)(np > 0 ? np : 1) * sizeof *sorted);
-    if (!box || !sorted) {
-        free(box);
-        free(sorted);
-        return SEM_ERR_NOMEM;
-    }
-    for (int i = 0; i < np; ++i)
+    for (int i = 0; i < d->n_parts; ++i)
         for (int e = 0; e < 3; ++e) {
             box[6 * i + e] = INFINITY;
             box[6 * i + 3 + e] = -INFINITY;
@@ -298,6 +290,19 @@ sem_status sem_part_sizes(const sem_discretization *d, double *size, double *med
             b[3 + e] = fmax(b[3 + e], Y[e]);
         }
     }
+}
+
+sem_status sem_part_sizes(const sem_discretization *d, double *size, double *median)
+{
+    int np = d->n_parts;
+    double *box = malloc(6 * (size_t)(np > 0 ? np : 1) * sizeof *box);
+    double *sorted = malloc((size_t)(np > 0 ? np : 1) * sizeof *sorted);
+    if (!box || !sorted) {
+        free(box);
+        free(sorted);
+        return SEM_ERR_NOMEM;
+    }
+    sem_part_frame_boxes(d, box);
     int n = 0;
     for (int i = 0; i < np; ++i) {
         const double *b = box + 6 * (size_t)i;

@@ -37,6 +37,7 @@
  * else the origin of coordinates.
  */
 #include "steps.h"
+#include "util/free_all.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -188,6 +189,15 @@ static sem_status solve_assignment(const sem_discretization *d, const origin_gro
     return SEM_OK;
 }
 
+void sem_set_origins(sem_discretization *d, double *origin_X, int *part_origin, int n_origins)
+{
+    free(d->origin_X);
+    free(d->part_origin);
+    d->origin_X = origin_X;
+    d->part_origin = part_origin;
+    d->n_origins = n_origins;
+}
+
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err)
 {
     (void)model;
@@ -268,23 +278,13 @@ sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_e
                 origin_X[3 * (size_t)j + e] = o[4 + e] / o[7];
         }
     }
-    free(d->origin_X);
-    free(d->part_origin);
-    d->n_origins = n_origins;
-    d->origin_X = origin_X;
-    d->part_origin = part_origin;
+    sem_set_origins(d, origin_X, part_origin, n_origins);
     part_origin = NULL;
     origin_X = NULL;
 
 done:
     if (groups && n_groups > 0)
         for (int g = 0; g < n_groups; ++g) free(groups[g].cost);
-    free(groups);
-    free(assigned);
-    free(group_origin);
-    free(part_origin);
-    free(acc);
-    free(origin_X);
-    free(origin_acc);
+    SEM_FREE_ALL(groups, assigned, group_origin, part_origin, acc, origin_X, origin_acc);
     return st;
 }

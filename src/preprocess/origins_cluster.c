@@ -37,7 +37,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/flatness.h"
 #include "steps.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 /* A group whose samples' second-moment eigenvalues have a smaller/larger ratio than this is
@@ -56,23 +58,6 @@ static int pair_cmp(const void *x, const void *y)
     const pair_coupling *p = x, *q = y;
     if (p->a != q->a) return (p->a > q->a) - (p->a < q->a);
     return (p->b > q->b) - (p->b < q->b);
-}
-
-/* Smallest / largest eigenvalue of a symmetric 3x3 (xx yy zz xy xz yz), closed form. */
-static double eigen_ratio(const double C[6])
-{
-    double a = C[0], b = C[1], c = C[2], d = C[3], e = C[4], f = C[5];
-    double p1 = d * d + e * e + f * f, q = (a + b + c) / 3.0;
-    double p2 = (a - q) * (a - q) + (b - q) * (b - q) + (c - q) * (c - q) + 2.0 * p1;
-    double p = sqrt(p2 / 6.0);
-    if (!(p > 0)) return q > 0 ? 1.0 : 0.0;
-    double B[6] = {(a - q) / p, (b - q) / p, (c - q) / p, d / p, e / p, f / p};
-    double det = B[0] * (B[1] * B[2] - B[5] * B[5]) - B[3] * (B[3] * B[2] - B[5] * B[4]) +
-                 B[4] * (B[3] * B[5] - B[1] * B[4]);
-    double r = det / 2.0;
-    double phi = r <= -1 ? M_PI / 3.0 : r >= 1 ? 0.0 : acos(r) / 3.0;
-    double l1 = q + 2.0 * p * cos(phi), l3 = q + 2.0 * p * cos(phi + 2.0 * M_PI / 3.0);
-    return l1 > 0 ? fmax(l3, 0.0) / l1 : 0.0;
 }
 
 /* Per group root: area, first and second moments of its samples (10 numbers). */
@@ -102,7 +87,7 @@ static double group_ratio(const double *m)
     double C[6] = {m[4] / m[0] - c[0] * c[0], m[5] / m[0] - c[1] * c[1],
                    m[6] / m[0] - c[2] * c[2], m[7] / m[0] - c[0] * c[1],
                    m[8] / m[0] - c[0] * c[2], m[9] / m[0] - c[1] * c[2]};
-    return eigen_ratio(C);
+    return sem_eigenvalue_ratio(C);
 }
 
 /* The ratio of the union of two groups (moments add). */
@@ -300,25 +285,12 @@ sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err)
                 for (int e = 0; e < 3; ++e) x[e] = mi[1 + e] / mi[0];
         }
         free(root_origin);
-        free(d->origin_X);
-        free(d->part_origin);
-        d->origin_X = X;
-        d->part_origin = part_origin;
-        d->n_origins = n_origins;
+        sem_set_origins(d, X, part_origin, n_origins);
     }
     goto done;
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
 done:
-    free(parent);
-    free(join);
-    free(self);
-    free(gself);
-    free(best);
-    free(mom);
-    free(settled);
-    free(any_improving);
-    free(pc);
-    free(gpc);
+    SEM_FREE_ALL(parent, join, self, gself, best, mom, settled, any_improving, pc, gpc);
     return st;
 }

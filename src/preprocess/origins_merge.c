@@ -17,26 +17,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/flatness.h"
 #include "steps.h"
-
-/* smallest / largest eigenvalue of a symmetric 3x3 (closed form, Smith 1961) */
-static double eig_ratio(const double C[6])
-{
-    double a = C[0], b = C[1], c = C[2], d = C[3], e = C[4], f = C[5]; /* xx yy zz xy xz yz */
-    double p1 = d * d + e * e + f * f;
-    double q = (a + b + c) / 3.0;
-    double p2 = (a - q) * (a - q) + (b - q) * (b - q) + (c - q) * (c - q) + 2.0 * p1;
-    double p = sqrt(p2 / 6.0);
-    if (!(p > 0)) return q > 0 ? 1.0 : 0.0;
-    double B[6] = {(a - q) / p, (b - q) / p, (c - q) / p, d / p, e / p, f / p};
-    double detB = B[0] * (B[1] * B[2] - B[5] * B[5]) - B[3] * (B[3] * B[2] - B[5] * B[4]) +
-                  B[4] * (B[3] * B[5] - B[1] * B[4]);
-    double r = detB / 2.0;
-    double phi = r <= -1 ? M_PI / 3.0 : r >= 1 ? 0.0 : acos(r) / 3.0;
-    double l1 = q + 2.0 * p * cos(phi);
-    double l3 = q + 2.0 * p * cos(phi + 2.0 * M_PI / 3.0);
-    return l1 > 0 ? l3 / l1 : 0.0;
-}
+#include "util/free_all.h"
 
 /* second moments of the samples of the parts in origin j about their centroid */
 static void moments(const sem_discretization *d, const int *part_origin, int j, double centroid[3],
@@ -94,7 +77,7 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err)
             if (!alive[j]) continue;
             double C[6], area;
             moments(d, d->part_origin, j, cent + 3 * j, C, &area);
-            if (area > 0 && eig_ratio(C) > 1e-8) continue;
+            if (area > 0 && sem_eigenvalue_ratio(C) > 1e-8) continue;
             /* degenerate: the most linked live origin, else the nearest one */
             int best = -1;
             double bl = 0;
@@ -144,10 +127,7 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err)
     if (n_new != no) {
         double *X = malloc(3 * (size_t)n_new * sizeof(double));
         if (!X) {
-            free(map);
-            free(link);
-            free(alive);
-            free(cent);
+            SEM_FREE_ALL(map, link, alive, cent);
             return sem_error_set(err, SEM_ERR_NOMEM, "out of memory merging origins");
         }
         for (int i = 0; i < np; ++i) d->part_origin[i] = map[d->part_origin[i]];
@@ -159,9 +139,6 @@ sem_status sem_merge_degenerate_origins(sem_discretization *d, sem_error *err)
         d->origin_X = X;
         d->n_origins = n_new;
     }
-    free(map);
-    free(link);
-    free(alive);
-    free(cent);
+    SEM_FREE_ALL(map, link, alive, cent);
     return SEM_OK;
 }

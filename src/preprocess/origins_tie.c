@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 #include "util/union_find.h"
 
 /* A boundary sample couples two origins when both carry at least this weight there. */
@@ -97,11 +98,7 @@ sem_status sem_merge_origins(sem_discretization *d, int *merge, sem_error *err)
         if (A[o] > 0)
             for (int e = 0; e < 3; ++e) X[3 * (size_t)o + e] /= A[o];
     free(A);
-    free(d->origin_X);
-    free(d->part_origin);
-    d->origin_X = X;
-    d->part_origin = part_origin;
-    d->n_origins = n_new;
+    sem_set_origins(d, X, part_origin, n_new);
     return SEM_OK;
 }
 
@@ -184,10 +181,6 @@ sem_status sem_tie_translation_components(sem_discretization *d, int *n_ties, se
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "origins: out of memory");
 done:
-    free(comp);
-    free(merge);
-    free(seen);
-    free(acc);
-    free(pairs);
+    SEM_FREE_ALL(comp, merge, seen, acc, pairs);
     return st;
 }

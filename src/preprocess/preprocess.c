@@ -31,6 +31,7 @@
 #include "sem/limits.h"
 #include "steps.h"
 #include "util/fnv_hash.h"
+#include "util/free_all.h"
 
 /* ------------------------------------------------------------------------------------ */
 /* options                                                                               */
@@ -250,17 +251,9 @@ unsigned long long sem_preprocess_hash(const sem_model *model, const sem_preproc
 void sem_discretization_destroy(sem_discretization *d)
 {
     if (!d) return;
-    free(d->part_ctrl_offset);
-    free(d->sample_part);
-    free(d->sample_uv);
-    free(d->sample_X);
-    free(d->sample_area);
-    free(d->sample_seam);
+    SEM_FREE_ALL(d->part_ctrl_offset, d->sample_part, d->sample_uv, d->sample_X, d->sample_area, d->sample_seam);
     sem_csr_free(&d->J_hat);
-    free(d->quad_X);
-    free(d->quad_volume);
-    free(d->quad_part);
-    free(d->part_covered);
+    SEM_FREE_ALL(d->quad_X, d->quad_volume, d->quad_part, d->part_covered);
     sem_csr_free(&d->W);
     sem_csr_free(&d->W_samples);
     free(d->origin_X);

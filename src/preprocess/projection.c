@@ -66,6 +66,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 
 /* Relative eigenvalue threshold below which a fit direction counts as undetermined. */
 #define SEM_PROJECTION_NULL_TOL 1e-8
@@ -423,10 +424,7 @@ static sem_status part_solve(const context *cx, int i, sem_csr *Pi, const int *g
     double *C2 = k2 ? malloc(N2 * nc * sizeof *C2) : NULL;
     double *RG = k2 ? malloc(N2 * nc * sizeof *RG) : NULL;
     if (!R || !C1 || (k2 && (!C2 || !RG))) {
-        free(R);
-        free(C1);
-        free(C2);
-        free(RG);
+        SEM_FREE_ALL(R, C1, C2, RG);
         return SEM_ERR_NOMEM;
     }
     double K_own[N2 * N2], K_group[N2 * N2];
@@ -483,10 +481,7 @@ static sem_status part_solve(const context *cx, int i, sem_csr *Pi, const int *g
             Pi->val[start + c] = scale * src[c];
         }
     }
-    free(R);
-    free(C1);
-    free(C2);
-    free(RG);
+    SEM_FREE_ALL(R, C1, C2, RG);
     return SEM_OK;
 }
 
@@ -504,10 +499,7 @@ static void context_free(context *cx, int n_parts, int n_origins)
     free(cx->sums);
     if (cx->groups)
         for (int j = 0; j < n_origins; ++j) {
-            free(cx->groups[j].parts);
-            free(cx->groups[j].t);
-            free(cx->groups[j].R1);
-            free(cx->groups[j].B2);
+            SEM_FREE_ALL(cx->groups[j].parts, cx->groups[j].t, cx->groups[j].R1, cx->groups[j].B2);
         }
     free(cx->groups);
 }

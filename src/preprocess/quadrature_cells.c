@@ -40,6 +40,7 @@
 #include <lapacke.h>
 
 #include "quadrature_subrays.h"
+#include "util/free_all.h"
 #include "util/grow.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
@@ -183,27 +184,13 @@ static int column(const cell_grid *g, const sem_subray_column *rays, int i, int 
     const int n_cells = b->offset[n0];
     if (!grow((void **)&b->volume, &b->cap_cells, n_cells, sizeof *b->volume)) return 0;
     const size_t cap = (size_t)b->cap_cells;
-    double *m = realloc(b->moment, 3 * cap * sizeof *m);
-    if (!m) return 0;
-    b->moment = m;
-    double *m2 = realloc(b->second, 6 * cap * sizeof *m2);
-    if (!m2) return 0;
-    b->second = m2;
-    double *dv = realloc(b->dvolume, cap * sizeof *dv);
-    if (!dv) return 0;
-    b->dvolume = dv;
-    double *dm = realloc(b->dmoment, 3 * cap * sizeof *dm);
-    if (!dm) return 0;
-    b->dmoment = dm;
-    double *bv = realloc(b->base_volume, cap * sizeof *bv);
-    if (!bv) return 0;
-    b->base_volume = bv;
-    int *cp = realloc(b->part, cap * sizeof *cp);
-    if (!cp) return 0;
-    b->part = cp;
-    unsigned char *kp = realloc(b->keep, cap);
-    if (!kp) return 0;
-    b->keep = kp;
+    if (!sem_resize((void **)&b->moment, 3 * cap, sizeof *b->moment) ||
+        !sem_resize((void **)&b->second, 6 * cap, sizeof *b->second) ||
+        !sem_resize((void **)&b->dvolume, cap, sizeof *b->dvolume) ||
+        !sem_resize((void **)&b->dmoment, 3 * cap, sizeof *b->dmoment) ||
+        !sem_resize((void **)&b->base_volume, cap, sizeof *b->base_volume) ||
+        !sem_resize((void **)&b->part, cap, sizeof *b->part) || !sem_resize((void **)&b->keep, cap, 1))
+        return 0;
     memset(b->volume, 0, (size_t)n_cells * sizeof *b->volume);
     memset(b->moment, 0, 3 * (size_t)n_cells * sizeof *b->moment);
     memset(b->second, 0, 6 * (size_t)n_cells * sizeof *b->second);
@@ -384,20 +371,7 @@ static double refine(const sem_discretization *d, cell_grid *g, int max_level)
         free(box);
         return -1;
     }
-    for (int p = 0; p < np; ++p)
-        for (int e = 0; e < 3; ++e) {
-            box[6 * p + e] = INFINITY;
-            box[6 * p + 3 + e] = -INFINITY;
-        }
-    for (int s = 0; s < d->n_samples; ++s) {
-        double Y[3];
-        sem_frame_coordinates(d, d->sample_X + 3 * (size_t)s, Y);
-        double *bx = box + 6 * (size_t)d->sample_part[s];
-        for (int e = 0; e < 3; ++e) {
-            bx[e] = fmin(bx[e], Y[e]);
-            bx[3 + e] = fmax(bx[3 + e], Y[e]);
-        }
-    }
+    sem_part_frame_boxes(d, box);
     const double h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     for (int p = 0; p < np; ++p) {
         double want = size[p] / SMALL_PART_CELLS;
@@ -511,16 +485,8 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
             if (!b.offset) continue;
             if (!column(&g, &rays[c], c % g.n[1], c / g.n[1], &b, &cols[c])) failed |= 1;
         }
-        free(b.offset);
-        free(b.volume);
-        free(b.moment);
-        free(b.second);
-        free(b.dvolume);
-        free(b.dmoment);
-        free(b.base_volume);
-        free(b.part);
-        free(b.keep);
-        free(b.entries);
+        SEM_FREE_ALL(b.offset, b.volume, b.moment, b.second, b.dvolume, b.dmoment, b.base_volume, b.part, b.keep,
+                     b.entries);
     }
     if (n_rays)
         for (int c = 0; c < n_columns; ++c) *n_rays += rays[c].rays;

@@ -39,6 +39,7 @@
 #include "sem/nurbs.h"
 #include "sem/trim.h"
 #include "steps.h"
+#include "util/free_all.h"
 
 /* Relative shift of a trim test point towards its span centre (see the opening comment). */
 #define SEM_TRIM_NUDGE 1e-9
@@ -62,13 +63,7 @@ typedef struct part_samples {
 
 static void part_samples_free(part_samples *p)
 {
-    free(p->uv);
-    free(p->X);
-    free(p->area);
-    free(p->seam);
-    free(p->row_nnz);
-    free(p->col);
-    free(p->val);
+    SEM_FREE_ALL(p->uv, p->X, p->area, p->seam, p->row_nnz, p->col, p->val);
 }
 
 static int lobatto_points(int degree)
@@ -233,10 +228,7 @@ static void sample_part(const sem_part *part, int index, part_samples *out)
 nomem:
     out->status = sem_error_set(&out->err, SEM_ERR_NOMEM, "out of memory sampling part %d", index);
 done:
-    free(bu);
-    free(bv);
-    free(index_buf);
-    free(phi);
+    SEM_FREE_ALL(bu, bv, index_buf, phi);
     sem_trim_region_destroy(trim);
 }
 
@@ -347,12 +339,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
     for (int i = 0; i < n_parts; ++i) part_samples_free(&parts[i]);
     free(parts);
     if (st != SEM_OK) {
-        free(sample_part_idx);
-        free(uv);
-        free(X);
-        free(area);
-        free(seam);
-        free(ctrl_offset);
+        SEM_FREE_ALL(sample_part_idx, uv, X, area, seam, ctrl_offset);
         sem_csr_free(&J);
         return st;
     }

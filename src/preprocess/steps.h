@@ -26,6 +26,9 @@ int sem_samples_by_part(const sem_discretization *d, int **start, int **index);
 /* object_frame.c: fills frame_axes, frame_center, frame_lo, frame_hi from the scene's
  * tessellation (principal axes of the surface, degenerate ones fixed by the normals). */
 sem_status sem_step_frame(const sem_raycast_scene *scene, sem_discretization *d, sem_error *err);
+/* Every part's bounding box of its boundary samples in the frame (sem_frame_coordinates):
+ * 6 numbers a part, lower then upper corner (+inf then -inf for a part without samples). */
+void sem_part_frame_boxes(const sem_discretization *d, double *box);
 /* Size of every part (the diagonal of its boundary samples' bounding box in the frame, so it
  * does not change when the object is turned; 0 for a part without samples) into size (may be
  * NULL, n_parts entries) and the median over parts with samples into *median (may be NULL). */
@@ -122,6 +125,9 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
 
 /* origins.c: fills n_origins, origin_X, part_origin (Sec. 6.2, min-cost flow in GLPK). */
 sem_status sem_step_origins(const sem_model *model, sem_discretization *d, sem_error *err);
+/* origins.c: d's origins become these (d takes the arrays; the old ones are freed): every
+ * origin rule ends here. */
+void sem_set_origins(sem_discretization *d, double *origin_X, int *part_origin, int n_origins);
 /* origins_cluster.c: the default rule (SEM_ORIGINS_COUPLED): fills n_origins, origin_X,
  * part_origin by merging flat groups of parts with the parts they blend with most. */
 sem_status sem_step_origins_coupled(sem_discretization *d, sem_error *err);

@@ -48,6 +48,8 @@
  * are merged serially in point order, so W is identical for any thread count.
  */
 #include "steps.h"
+#include "util/free_all.h"
+#include "util/grow.h"
 
 #include <limits.h>
 #include <math.h>
@@ -76,10 +78,7 @@ typedef struct weight_candidates {
 
 static void candidates_free(weight_candidates *c)
 {
-    free(c->start);
-    free(c->part);
-    free(c->d_primary);
-    free(c->d_total);
+    SEM_FREE_ALL(c->start, c->part, c->d_primary, c->d_total);
     memset(c, 0, sizeof *c);
 }
 
@@ -95,15 +94,10 @@ static int buffer_reserve(candidate_buffer *b, size_t extra)
     if (b->n + extra <= b->cap) return 1;
     size_t cap = b->cap ? b->cap : 256;
     while (cap < b->n + extra) cap *= 2;
-    int *p = realloc(b->part, cap * sizeof *p);
-    if (!p) return 0;
-    b->part = p;
-    double *dp = realloc(b->d_primary, cap * sizeof *dp);
-    if (!dp) return 0;
-    b->d_primary = dp;
-    double *dt = realloc(b->d_total, cap * sizeof *dt);
-    if (!dt) return 0;
-    b->d_total = dt;
+    if (!sem_resize((void **)&b->part, cap, sizeof *b->part) ||
+        !sem_resize((void **)&b->d_primary, cap, sizeof *b->d_primary) ||
+        !sem_resize((void **)&b->d_total, cap, sizeof *b->d_total))
+        return 0;
     b->cap = cap;
     return 1;
 }
@@ -309,10 +303,7 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
                 point_offset[p] = base;
                 point_count[p] = (int)(b->n - base);
             }
-            free(parts);
-            free(dist);
-            free(points);
-            free(order);
+            SEM_FREE_ALL(parts, dist, points, order);
         }
     }
 
@@ -346,10 +337,7 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
             free(buffers[t].d_primary);
             free(buffers[t].d_total);
         }
-    free(buffers);
-    free(point_thread);
-    free(point_offset);
-    free(point_count);
+    SEM_FREE_ALL(buffers, point_thread, point_offset, point_count);
     if (failed) {
         candidates_free(out);
         return SEM_ERR_NOMEM;
@@ -420,6 +408,33 @@ static int max_candidates(const weight_candidates *c)
     return most;
 }
 
+/* evaluate_row's scratch, one per thread: room for the most candidates any point has. Both
+ * NULL, and *failed set, when out of memory. */
+typedef struct row_scratch {
+    int *cols;
+    double *vals;
+} row_scratch;
+
+static row_scratch row_scratch_alloc(int most, int *failed)
+{
+    row_scratch r = {malloc((size_t)most * sizeof *r.cols), malloc((size_t)most * sizeof *r.vals)};
+    if (!r.cols || !r.vals) {
+        free(r.cols);
+        free(r.vals);
+        r.cols = NULL;
+        r.vals = NULL;
+#pragma omp atomic write
+        *failed = 1;
+    }
+    return r;
+}
+
+static void row_scratch_free(row_scratch *r)
+{
+    free(r->cols);
+    free(r->vals);
+}
+
 /* Number of non-zero weights at cut-off alpha, or -1 when out of memory. */
 static long long count_nonzeros(const weight_candidates *c, double alpha, double threshold,
                                 int n_threads)
@@ -429,17 +444,11 @@ static long long count_nonzeros(const weight_candidates *c, double alpha, double
     int failed = 0;
 #pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1) reduction(+ : nnz)
     {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
-        }
+        row_scratch r = row_scratch_alloc(most, &failed);
 #pragma omp for schedule(static)
         for (int p = 0; p < c->n_points; ++p)
-            if (cols && vals) nnz += evaluate_row(c, p, alpha, threshold, cols, vals);
-        free(cols);
-        free(vals);
+            if (r.cols) nnz += evaluate_row(c, p, alpha, threshold, r.cols, r.vals);
+        row_scratch_free(&r);
     }
     return failed ? -1 : nnz;
 }
@@ -454,49 +463,35 @@ static sem_status build_matrix(const weight_candidates *c, int n_parts, double a
     int *length = malloc(((size_t)n + 1) * sizeof *length);
     if (!length) return SEM_ERR_NOMEM;
     int failed = 0;
+    /* Two passes over the rows with the same scratch: their lengths, then (with W sized) the
+     * rows themselves. evaluate_row uses room for every candidate before dropping small
+     * weights, so rows are evaluated in scratch and copied. */
 #pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1)
     {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
-        }
+        row_scratch r = row_scratch_alloc(most, &failed);
 #pragma omp for schedule(static)
         for (int p = 0; p < n; ++p)
-            length[p] = (cols && vals) ? evaluate_row(c, p, alpha, threshold, cols, vals) : 0;
-        free(cols);
-        free(vals);
-    }
-    size_t nnz = 0;
-    for (int p = 0; p < n; ++p) nnz += (size_t)length[p];
-    if (failed || nnz > (size_t)INT_MAX || sem_csr_alloc(W, n, n_parts, nnz) != SEM_OK) {
-        free(length);
-        sem_csr_free(W);
-        return SEM_ERR_NOMEM;
-    }
-    W->row_start[0] = 0;
-    for (int p = 0; p < n; ++p) W->row_start[p + 1] = W->row_start[p] + length[p];
-    /* evaluate_row uses room for every candidate before dropping small weights, so rows
-     * are evaluated in scratch and copied */
-#pragma omp parallel num_threads(n_threads > 0 ? n_threads : 1)
-    {
-        int *cols = malloc((size_t)most * sizeof *cols);
-        double *vals = malloc((size_t)most * sizeof *vals);
-        if (!cols || !vals) {
-#pragma omp atomic write
-            failed = 1;
+            length[p] = r.cols ? evaluate_row(c, p, alpha, threshold, r.cols, r.vals) : 0;
+#pragma omp single
+        {
+            size_t nnz = 0;
+            for (int p = 0; p < n; ++p) nnz += (size_t)length[p];
+            if (failed || nnz > (size_t)INT_MAX || sem_csr_alloc(W, n, n_parts, nnz) != SEM_OK) {
+                failed = 1;
+            } else {
+                W->row_start[0] = 0;
+                for (int p = 0; p < n; ++p) W->row_start[p + 1] = W->row_start[p] + length[p];
+            }
         }
 #pragma omp for schedule(static)
         for (int p = 0; p < n; ++p) {
-            if (!cols || !vals) continue;
+            if (failed || !r.cols) continue;
             const int at = W->row_start[p];
-            const int m = evaluate_row(c, p, alpha, threshold, cols, vals);
-            memcpy(&W->col[at], cols, (size_t)m * sizeof *cols);
-            memcpy(&W->val[at], vals, (size_t)m * sizeof *vals);
+            const int m = evaluate_row(c, p, alpha, threshold, r.cols, r.vals);
+            memcpy(&W->col[at], r.cols, (size_t)m * sizeof *r.cols);
+            memcpy(&W->val[at], r.vals, (size_t)m * sizeof *r.vals);
         }
-        free(cols);
-        free(vals);
+        row_scratch_free(&r);
     }
     free(length);
     if (failed) {

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/free_all.h"
 
 #define COVER_POINTS 8
 
@@ -81,16 +82,7 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     int *part_start = NULL, *part_samples = NULL;
     int grouped = sem_samples_by_part(d, &part_start, &part_samples);
     if (!rows || !cols || !vals || !scale || !dist || !near || !best || !grouped) {
-        free(rows);
-        free(cols);
-        free(vals);
-        free(scale);
-        free(dist);
-        free(near);
-        free(best);
-        free(seen);
-        free(part_start);
-        free(part_samples);
+        SEM_FREE_ALL(rows, cols, vals, scale, dist, near, best, seen, part_start, part_samples);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     }
     for (int p = 0; p < nq; ++p) scale[p] = 1.0;
@@ -185,15 +177,6 @@ sem_status sem_cover_unweighted_parts(sem_discretization *d, int *n_covered, sem
     } else {
         sem_error_set(err, st, "out of memory");
     }
-    free(rows);
-    free(cols);
-    free(vals);
-    free(scale);
-    free(dist);
-    free(near);
-    free(best);
-    free(seen);
-    free(part_start);
-    free(part_samples);
+    SEM_FREE_ALL(rows, cols, vals, scale, dist, near, best, seen, part_start, part_samples);
     return st;
 }

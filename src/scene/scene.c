@@ -17,6 +17,7 @@
 #include "io/read_file.h"
 #include "sem/limits.h"
 #include "sem/primitives.h"
+#include "util/free_all.h"
 
 typedef struct ctx {
     const char *name;
@@ -56,13 +57,21 @@ static sem_status check_keys(ctx *c, const cJSON *obj, const char *where, const 
     return SEM_OK;
 }
 
+/* The value of an optional key of obj (NULL when it is absent) and, in w, its place
+ * "where.key" for the messages about it. */
+static const cJSON *find_key(const cJSON *obj, const char *key, const char *where, char w[256])
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (v) snprintf(w, 256, "%s.%s", where, key);
+    return v;
+}
+
 static sem_status get_number(ctx *c, const cJSON *obj, const char *key, const char *where,
                              double *out)
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) return SEM_OK;
     char w[256];
-    snprintf(w, sizeof w, "%s.%s", where, key);
+    const cJSON *v = find_key(obj, key, where, w);
+    if (!v) return SEM_OK;
     if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble)) return fail(c, w, "must be a finite number");
     *out = v->valuedouble;
     return SEM_OK;
@@ -70,10 +79,9 @@ static sem_status get_number(ctx *c, const cJSON *obj, const char *key, const ch
 
 static sem_status get_int(ctx *c, const cJSON *obj, const char *key, const char *where, int *out)
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) return SEM_OK;
     char w[256];
-    snprintf(w, sizeof w, "%s.%s", where, key);
+    const cJSON *v = find_key(obj, key, where, w);
+    if (!v) return SEM_OK;
     if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble))
         return fail(c, w, "must be an integer");
     if (fabs(v->valuedouble) > 1e9)
@@ -84,13 +92,33 @@ static sem_status get_int(ctx *c, const cJSON *obj, const char *key, const char 
 
 static sem_status get_bool(ctx *c, const cJSON *obj, const char *key, const char *where, int *out)
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) return SEM_OK;
     char w[256];
-    snprintf(w, sizeof w, "%s.%s", where, key);
+    const cJSON *v = find_key(obj, key, where, w);
+    if (!v) return SEM_OK;
     if (!cJSON_IsBool(v)) return fail(c, w, "must be true or false");
     *out = cJSON_IsTrue(v);
     return SEM_OK;
+}
+
+/* An optional string key that names one of a few choices: *out = values[k] for names[k] (a
+ * NULL-terminated list); otherwise an error that lists the names. */
+static sem_status get_choice(ctx *c, const cJSON *obj, const char *key, const char *where,
+                             const char *const *names, const int *values, int *out)
+{
+    char w[256];
+    const cJSON *v = find_key(obj, key, where, w);
+    if (!v) return SEM_OK;
+    for (int k = 0; names[k]; ++k)
+        if (cJSON_IsString(v) && !strcmp(v->valuestring, names[k])) {
+            *out = values[k];
+            return SEM_OK;
+        }
+    char list[256] = "";
+    size_t len = 0;
+    for (int k = 0; names[k] && len < sizeof list; ++k)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s\"%s\"", k == 0 ? "" : names[k + 1] ? ", " : " or ",
+                                names[k]);
+    return fail(c, w, "must be %s", list);
 }
 
 static sem_status vec_n(ctx *c, const cJSON *v, const char *where, int n, double *out)
@@ -109,10 +137,9 @@ static sem_status vec_n(ctx *c, const cJSON *v, const char *where, int n, double
 static sem_status get_vec(ctx *c, const cJSON *obj, const char *key, const char *where, int n,
                           double *out)
 {
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v) return SEM_OK;
     char w[256];
-    snprintf(w, sizeof w, "%s.%s", where, key);
+    const cJSON *v = find_key(obj, key, where, w);
+    if (!v) return SEM_OK;
     return vec_n(c, v, w, n, out);
 }
 
@@ -184,9 +211,8 @@ static sem_status parse_transform(ctx *c, const cJSON *t, const char *where, dou
     mat_identity(T);
     char w[256];
     /* order: scale, then rotate, then translate (or a full matrix) */
-    const cJSON *m = cJSON_GetObjectItemCaseSensitive(t, "matrix");
+    const cJSON *m = find_key(t, "matrix", where, w);
     if (m) {
-        snprintf(w, sizeof w, "%s.matrix", where);
         if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 3) return fail(c, w, "must be 3 rows of 4 numbers");
         if (cJSON_GetObjectItemCaseSensitive(t, "scale") || cJSON_GetObjectItemCaseSensitive(t, "rotate") ||
             cJSON_GetObjectItemCaseSensitive(t, "translate"))
@@ -289,28 +315,12 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
         o->rays[0] = (int)rr[0];
         o->rays[1] = (int)rr[1];
     }
-    const cJSON *orr = cJSON_GetObjectItemCaseSensitive(s, "origins");
-    if (orr) {
-        snprintf(w, sizeof w, "%s.origins", where);
-        if (cJSON_IsString(orr) && !strcmp(orr->valuestring, "coupled"))
-            o->origin_rule = SEM_ORIGINS_COUPLED;
-        else if (cJSON_IsString(orr) && !strcmp(orr->valuestring, "paper"))
-            o->origin_rule = SEM_ORIGINS_PAPER;
-        else
-            return fail(c, w, "must be \"coupled\" or \"paper\"");
-    }
-    const cJSON *fit = cJSON_GetObjectItemCaseSensitive(s, "fit");
-    if (fit) {
-        snprintf(w, sizeof w, "%s.fit", where);
-        if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "auto"))
-            o->fit_rule = SEM_FIT_AUTO;
-        else if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "parts"))
-            o->fit_rule = SEM_FIT_PARTS;
-        else if (cJSON_IsString(fit) && !strcmp(fit->valuestring, "origins"))
-            o->fit_rule = SEM_FIT_ORIGINS;
-        else
-            return fail(c, w, "must be \"auto\", \"parts\" or \"origins\"");
-    }
+    static const char *const origin_names[] = {"coupled", "paper", NULL};
+    static const int origin_rules[] = {SEM_ORIGINS_COUPLED, SEM_ORIGINS_PAPER};
+    if ((st = get_choice(c, s, "origins", where, origin_names, origin_rules, &o->origin_rule)) != SEM_OK) return st;
+    static const char *const fit_names[] = {"auto", "parts", "origins", NULL};
+    static const int fit_rules[] = {SEM_FIT_AUTO, SEM_FIT_PARTS, SEM_FIT_ORIGINS};
+    if ((st = get_choice(c, s, "fit", where, fit_names, fit_rules, &o->fit_rule)) != SEM_OK) return st;
     const cJSON *spc = cJSON_GetObjectItemCaseSensitive(s, "spacing");
     if (spc && !cJSON_IsNull(spc)) {
         if ((st = get_number(c, s, "spacing", where, &o->spacing)) != SEM_OK) return st;
@@ -318,9 +328,8 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
         if (!(o->spacing > 0)) return fail(c, w, "must be positive or null (got %g)", o->spacing);
         if (r) return fail(c, where, "give either \"spacing\" or \"rays\", not both");
     }
-    const cJSON *ax = cJSON_GetObjectItemCaseSensitive(s, "ray_axis");
+    const cJSON *ax = find_key(s, "ray_axis", where, w);
     if (ax) {
-        snprintf(w, sizeof w, "%s.ray_axis", where);
         if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || !strchr("xyz", ax->valuestring[0]))
             return fail(c, w, "must be \"x\", \"y\" or \"z\"");
         o->ray_axis = ax->valuestring[0] - 'x';
@@ -467,9 +476,8 @@ static sem_status parse_shape(ctx *c, const cJSON *o, const char *where, const c
     mat_identity(obj->transform);
     const cJSON *model = cJSON_GetObjectItemCaseSensitive(o, "model");
     const cJSON *prim = cJSON_GetObjectItemCaseSensitive(o, "primitive");
-    const cJSON *units = cJSON_GetObjectItemCaseSensitive(o, "units");
+    const cJSON *units = find_key(o, "units", where, w);
     if (units) {
-        snprintf(w, sizeof w, "%s.units", where);
         if (!cJSON_IsString(units) ||
             (strcmp(units->valuestring, "as_metres") != 0 &&
              !(sem_unit_to_meter(units->valuestring, NULL) > 0)))
@@ -557,9 +565,8 @@ static sem_status parse_shape(ctx *c, const cJSON *o, const char *where, const c
             if (!(r < R)) return fail(c, w, "minor radius %g must be less than major radius %g", r, R);
         }
     }
-    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
+    const cJSON *t = find_key(o, "transform", where, w);
     if (t) {
-        snprintf(w, sizeof w, "%s.transform", where);
         if ((st = parse_transform(c, t, w, obj->transform)) != SEM_OK) return st;
     }
     return SEM_OK;
@@ -587,17 +594,15 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         snprintf(w, sizeof w, "%s.friction", where);
         return fail(c, w, "must be >= 0 (got %g)", obj->friction);
     }
-    const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "material");
+    const cJSON *m = find_key(o, "material", where, w);
     if (m) {
-        snprintf(w, sizeof w, "%s.material", where);
         if ((st = parse_material(c, m, w, &obj->material)) != SEM_OK) return st;
     } else {
         sem_error e;
         sem_material_init(&obj->material, &e);
     }
-    const cJSON *pm = cJSON_GetObjectItemCaseSensitive(o, "part_materials");
+    const cJSON *pm = find_key(o, "part_materials", where, w);
     if (pm) {
-        snprintf(w, sizeof w, "%s.part_materials", where);
         if (!cJSON_IsObject(pm)) return fail(c, w, "must map part indices or names to materials");
         int n = cJSON_GetArraySize(pm);
         obj->part_materials = calloc((size_t)n + 1, sizeof *obj->part_materials);
@@ -623,17 +628,9 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     if (s) {
         snprintf(w, sizeof w, "%s.sem", where);
         if ((st = parse_sem(c, s, w, &obj->sem)) != SEM_OK) return st;
-        const cJSON *sm = cJSON_GetObjectItemCaseSensitive(s, "seams");
-        if (sm) {
-            char w2[300];
-            snprintf(w2, sizeof w2, "%s.seams", w);
-            if (cJSON_IsString(sm) && !strcmp(sm->valuestring, "geometric"))
-                obj->seams = SEM_SEAMS_GEOMETRIC;
-            else if (cJSON_IsString(sm) && !strcmp(sm->valuestring, "paper"))
-                obj->seams = SEM_SEAMS_PAPER;
-            else
-                return fail(c, w2, "must be \"geometric\" or \"paper\"");
-        }
+        static const char *const seam_names[] = {"geometric", "paper", NULL};
+        static const int seam_rules[] = {SEM_SEAMS_GEOMETRIC, SEM_SEAMS_PAPER};
+        if ((st = get_choice(c, s, "seams", w, seam_names, seam_rules, &obj->seams)) != SEM_OK) return st;
         if ((st = get_bool(c, s, "weld", w, &obj->weld)) != SEM_OK) return st;
         const cJSON *res = cJSON_GetObjectItemCaseSensitive(s, "resolution");
         if (res && !cJSON_IsNull(res)) {
@@ -654,9 +651,8 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             }
         }
     }
-    const cJSON *pin = cJSON_GetObjectItemCaseSensitive(o, "pin");
+    const cJSON *pin = find_key(o, "pin", where, w);
     if (pin) {
-        snprintf(w, sizeof w, "%s.pin", where);
         if ((st = parse_selection(c, pin, w, &obj->has_pin_box, obj->pin_box, &obj->has_pin_control_box,
                                   obj->pin_control_box, &obj->pin_parts, &obj->n_pin_parts, &obj->pin_points,
                                   &obj->n_pin_points)) != SEM_OK)
@@ -709,9 +705,8 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             return fail(c, w, "must be positive");
         }
     }
-    const cJSON *pl = cJSON_GetObjectItemCaseSensitive(o, "point_loads");
+    const cJSON *pl = find_key(o, "point_loads", where, w);
     if (pl) {
-        snprintf(w, sizeof w, "%s.point_loads", where);
         if (!cJSON_IsArray(pl)) return fail(c, w, "must be an array");
         int n = cJSON_GetArraySize(pl);
         obj->point_loads = calloc((size_t)n + 1, sizeof *obj->point_loads);
@@ -729,9 +724,8 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
             obj->n_point_loads = k + 1;
         }
     }
-    const cJSON *rl = cJSON_GetObjectItemCaseSensitive(o, "region_loads");
+    const cJSON *rl = find_key(o, "region_loads", where, w);
     if (rl) {
-        snprintf(w, sizeof w, "%s.region_loads", where);
         if (!cJSON_IsArray(rl)) return fail(c, w, "must be an array");
         int n = cJSON_GetArraySize(rl);
         obj->region_loads = calloc((size_t)n + 1, sizeof *obj->region_loads);
@@ -942,11 +936,7 @@ static sem_status parse_world(ctx *c, const cJSON *root, sem_scene *s)
 
 static void object_free(sem_scene_object *o)
 {
-    free(o->part_materials);
-    free(o->pin_parts);
-    free(o->pin_points);
-    free(o->point_loads);
-    free(o->region_loads);
+    SEM_FREE_ALL(o->part_materials, o->pin_parts, o->pin_points, o->point_loads, o->region_loads);
     for (int k = 0; k < o->n_prescribe_groups; ++k) {
         free(o->prescribe_groups[k].parts);
         free(o->prescribe_groups[k].points);

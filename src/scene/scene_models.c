@@ -71,6 +71,15 @@ sem_status sem_scene_object_model(const sem_scene *scene, int index, sem_model *
     return sem_scene_object_model_units(scene, index, out, NULL, NULL, err);
 }
 
+/* Puts "name: where<key>: " before err's message (the step that failed, told where). */
+static void name_where(sem_error *err, sem_status st, const char *name, const char *where, const char *key)
+{
+    if (!err) return;
+    char msg[sizeof err->message];
+    snprintf(msg, sizeof msg, "%s", err->message);
+    sem_error_set(err, st, "%s: %s%s: %s", name, where, key, msg);
+}
+
 /* The model of an object's or a collider's shape (where: "objects[0]", "colliders[1]"), in
  * metres and transformed. */
 static sem_status shape_model(const sem_scene *scene, const sem_scene_object *o, const char *where,
@@ -83,11 +92,7 @@ static sem_status shape_model(const sem_scene *scene, const sem_scene_object *o,
         st = sem_model_load(o->model_path, &m, err);
         if (st != SEM_OK) {
             /* always name the key: "scene.json: objects[0].model: dir/x.igs: cannot open: ..." */
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s.model: %s", scene->path[0] ? scene->path : "scene", where, msg);
-            }
+            name_where(err, st, scene->path[0] ? scene->path : "scene", where, ".model");
             return st;
         }
     } else {
@@ -187,11 +192,7 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
         /* a plain triangle mesh, unless the file holds free-form surfaces */
         st = sem_obj_triangles_read(o->model_path, &soup, &freeform, err);
         if (st != SEM_OK) {
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s.model: %s", name, where, msg);
-            }
+            name_where(err, st, name, where, ".model");
             return st;
         }
     }
@@ -213,11 +214,7 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
         st = sem_mesh_from_model(m, COLLIDER_RESOLUTION, &mesh, err);
         sem_model_destroy(m);
         if (st != SEM_OK) {
-            if (err) {
-                char msg[sizeof err->message];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                sem_error_set(err, st, "%s: %s: %s", name, where, msg);
-            }
+            name_where(err, st, name, where, "");
             return st;
         }
         soup.n_vertices = mesh.n_vertices;
@@ -242,6 +239,20 @@ sem_status sem_scene_collider_def(const sem_scene *scene, int index, sem_collide
     return SEM_OK;
 }
 
+/* Does parts[0..n-1] (a pin's or a prescribed group's "parts") name part i? */
+static int lists_part(const int *parts, int n, int i)
+{
+    int listed = 0;
+    for (int k = 0; k < n; ++k) listed |= parts[k] == i;
+    return listed;
+}
+
+/* Is x inside box b (lower corner, upper corner), its faces included? */
+static int in_box(const double x[3], const double b[6])
+{
+    return x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] && x[1] <= b[4] && x[2] <= b[5];
+}
+
 sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, unsigned char **out,
                                  sem_error *err)
 {
@@ -258,15 +269,10 @@ sem_status sem_scene_object_pins(const sem_scene_object *o, const sem_model *m, 
     sem_model_part_offsets(m, off);
     for (int i = 0; i < m->n_parts; ++i) {
         const sem_surface *s = &m->parts[i].surface;
-        int whole = 0;
-        for (int k = 0; k < o->n_pin_parts; ++k) whole |= o->pin_parts[k] == i;
-        for (int c = 0; c < s->n_u * s->n_v; ++c) {
-            const double *x = s->ctrl + 3 * c;
-            const double *b = o->pin_control_box;
-            int in = o->has_pin_control_box && x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] &&
-                     x[1] <= b[4] && x[2] <= b[5];
-            if (in || whole) pin[off[i] + (size_t)c] = 1;
-        }
+        int whole = lists_part(o->pin_parts, o->n_pin_parts, i);
+        for (int c = 0; c < s->n_u * s->n_v; ++c)
+            if (whole || (o->has_pin_control_box && in_box(s->ctrl + 3 * c, o->pin_control_box)))
+                pin[off[i] + (size_t)c] = 1;
     }
     for (int k = 0; k < o->n_pin_parts; ++k)
         if (o->pin_parts[k] >= m->n_parts) {
@@ -397,18 +403,12 @@ sem_status sem_scene_object_prescribe_groups(const sem_scene_object *o, const se
             }
         for (int i = 0; i < m->n_parts; ++i) {
             const sem_surface *s = &m->parts[i].surface;
-            int whole = 0;
-            for (int k = 0; k < gr->n_parts; ++k) whole |= gr->parts[k] == i;
-            for (int c = 0; c < s->n_u * s->n_v; ++c) {
-                const double *x = s->ctrl + 3 * c;
-                const double *b = gr->control_box;
-                int in = gr->has_control_box && x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] &&
-                         x[1] <= b[4] && x[2] <= b[5];
-                if (in || whole) {
+            int whole = lists_part(gr->parts, gr->n_parts, i);
+            for (int c = 0; c < s->n_u * s->n_v; ++c)
+                if (whole || (gr->has_control_box && in_box(s->ctrl + 3 * c, gr->control_box))) {
                     group[off[i] + (size_t)c] = g;
                     count++;
                 }
-            }
         }
         for (int k = 0; k < gr->n_points; ++k) {
             group[gr->points[k]] = g;

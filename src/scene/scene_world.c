@@ -26,6 +26,7 @@
 #include "sem/refine.h"
 #include "sem/scene.h"
 #include "sem/tessellate.h"
+#include "util/free_all.h"
 
 struct sem_scene_world {
     const sem_scene *scene;
@@ -132,18 +133,38 @@ void sem_scene_world_destroy(sem_scene_world *sw)
         if (sw->prescribes) free(sw->prescribes[i]);
         if (sw->materials) free(sw->materials[i]);
     }
-    free(sw->models);
-    free(sw->patches);
-    free(sw->discs);
-    free(sw->pins);
-    free(sw->part_material);
-    free(sw->prescribe_group);
-    free(sw->prescribes);
-    free(sw->materials);
-    free(sw->file_unit_to_meter);
-    free(sw->file_units);
-    free(sw->spurious);
+    SEM_FREE_ALL(sw->models, sw->patches, sw->discs, sw->pins, sw->part_material, sw->prescribe_group, sw->prescribes,
+                 sw->materials, sw->file_unit_to_meter, sw->file_units, sw->spurious);
     free(sw);
+}
+
+/* The parts with marks[k] != 0 for a warning, "k (name)" after ", ", the first 12 of them
+ * (*listed; *more are left out) into parts; returns the length written. with_counts: each
+ * also says how many of the part's control points marks[k] counts ("k (name; c of its n)"). */
+static size_t list_parts(const sem_model *model, const int *marks, int with_counts, char *parts, size_t size,
+                         int *listed, int *more)
+{
+    size_t len = 0;
+    parts[0] = '\0';
+    *listed = *more = 0;
+    for (int k = 0; k < model->n_parts; ++k) {
+        if (!marks[k]) continue;
+        if (*listed == 12) {
+            (*more)++;
+            continue;
+        }
+        const char *nm = model->parts[k].name, *sep = *listed ? ", " : "";
+        int of = model->parts[k].surface.n_u * model->parts[k].surface.n_v, w;
+        if (with_counts)
+            w = nm[0] ? snprintf(parts + len, size - len, "%s%d (%s; %d of its %d)", sep, k, nm, marks[k], of)
+                      : snprintf(parts + len, size - len, "%s%d (%d of its %d)", sep, k, marks[k], of);
+        else
+            w = nm[0] ? snprintf(parts + len, size - len, "%s%d (%s)", sep, k, nm)
+                      : snprintf(parts + len, size - len, "%s%d", sep, k);
+        if (w > 0 && (size_t)w < size - len) len += (size_t)w;
+        (*listed)++;
+    }
+    return len;
 }
 
 /* Control points the boundary samples do not determine (sem_world_object_tied_points): one
@@ -156,24 +177,9 @@ static void warn_tied_points(sem_scene_world *sw, int i, int id, const sem_scene
     if (!counts) return;
     int total = sem_world_object_tied_points(sw->world, id, counts);
     if (total > 0) {
-        char parts[600] = "";
-        size_t len = 0;
-        int listed = 0, more = 0;
-        for (int k = 0; k < model->n_parts; ++k) {
-            if (!counts[k]) continue;
-            if (listed == 12) {
-                more++;
-                continue;
-            }
-            const char *nm = model->parts[k].name;
-            int of = model->parts[k].surface.n_u * model->parts[k].surface.n_v;
-            int w = nm[0] ? snprintf(parts + len, sizeof parts - len, "%s%d (%s; %d of its %d)",
-                                     listed ? ", " : "", k, nm, counts[k], of)
-                          : snprintf(parts + len, sizeof parts - len, "%s%d (%d of its %d)", listed ? ", " : "",
-                                     k, counts[k], of);
-            if (w > 0 && (size_t)w < sizeof parts - len) len += (size_t)w;
-            listed++;
-        }
+        char parts[600];
+        int listed, more;
+        size_t len = list_parts(model, counts, 1, parts, sizeof parts, &listed, &more);
         if (more) snprintf(parts + len, sizeof parts - len, " and %d more part%s", more, more == 1 ? "" : "s");
         logf_(o, 1,
               "objects[%d]: %d control point%s seen by no boundary sample (outside the part's trim or "
@@ -199,21 +205,9 @@ static sem_status check_modes(sem_scene_world *sw, int i, int id, const sem_scen
     }
     sw->spurious[i] = m.spurious;
     if (m.spurious > 0) {
-        char parts[600] = "";
-        size_t len = 0;
-        int listed = 0, more = 0;
-        for (int k = 0; k < model->n_parts; ++k) {
-            if (!flags[k]) continue;
-            if (listed == 12) {
-                more++;
-                continue;
-            }
-            const char *nm = model->parts[k].name;
-            int w = nm[0] ? snprintf(parts + len, sizeof parts - len, "%s%d (%s)", listed ? ", " : "", k, nm)
-                          : snprintf(parts + len, sizeof parts - len, "%s%d", listed ? ", " : "", k);
-            if (w > 0 && (size_t)w < sizeof parts - len) len += (size_t)w;
-            listed++;
-        }
+        char parts[600];
+        int listed, more;
+        size_t len = list_parts(model, flags, 0, parts, sizeof parts, &listed, &more);
         if (more) snprintf(parts + len, sizeof parts - len, " and %d more", more);
         logf_(o, 1,
               "objects[%d]: %s%d zero-energy mode%s beyond the rigid motions: part%s %s %s not held by the "

@@ -15,3 +15,11 @@ int sem_grow(void **p, int *cap, int need, size_t elem, int first, int max)
     *cap = nc;
     return 1;
 }
+
+int sem_resize(void **p, size_t count, size_t elem)
+{
+    void *q = realloc(*p, count * elem);
+    if (!q) return 0;
+    *p = q;
+    return 1;
+}
