@@ -411,10 +411,12 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
             r.d = sem_signed_distance(x, cl.point, outward, r.n);
             /* a point found deeper than the thickness behind its own surface got there by no
              * fold (an embedded or overlapping part, faces coming apart, a step through a
-             * sheet): no contact, so that no spring appears at full depth (an energy that
-             * jumps by 1/2 k d^2 between Newton's iterates) */
-            if (r.d >= -th && r.d < *min_gap && r.d < radius) *min_gap = r.d;
-            if (r.d >= -th && r.d < th + margin * radius) {
+             * sheet; a resting contact sinks far less): no contact, so that no spring appears
+             * at full depth (an energy that jumps by 1/2 k d^2 between Newton's iterates; the
+             * chicken's step 37 failed so with 0.01 L as the limit) */
+            double deepest = -th;
+            if (r.d >= deepest && r.d < *min_gap && r.d < radius) *min_gap = r.d;
+            if (r.d >= deepest && r.d < th + margin * radius) {
                 r.stiffness = own_stiffness * m->area[p];
                 r.mu = co->friction;
                 out[n++] = r;
