@@ -49,6 +49,8 @@ typedef struct contact_object {
     int built;               /* mesh and the numbers below (mesh_for) */
     sem_collision_mesh mesh;
     double youngs, friction, length, thickness;
+    int self_far;            /* at the last detection no point can reach its own surface
+                              * beyond the exclusion rule (self_far_apart): no self query */
 } contact_object;
 
 /* An active contact: point `point` of system object k against a collider or a triangle of
@@ -330,6 +332,80 @@ static int self_excluded(int t, void *context)
     return !(cl.dist2 >= e->radius2); /* a degenerate triangle (NaN distance) is left out too */
 }
 
+/* 3 x 3 determinant, row-major */
+static double det3(const double *a)
+{
+    return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+/* Is the mesh so close to a rigid motion of its rest shape that no point can be within the
+ * search radius of a triangle the exclusion rule leaves it? With x_p = c + R (x0_p - c0) +
+ * e_p for a rotation R and |e_p| <= D at every point (so at every point of a triangle), two
+ * points at rest distance >= SELF_EXCLUSION x radius are now >= that - 2 D apart: beyond the
+ * radius when 2 D < (SELF_EXCLUSION - 1) radius (with a 1 % margin for rounding). R is the
+ * polar factor of the points' cross-covariance (Higham's iteration), made orthonormal; any
+ * rotation makes the bound true, a good one makes it tight. A falling or tumbling object that
+ * hardly deforms then pays O(n) per detection for self-contact instead of a tree query per
+ * point. 0 when the test cannot tell (a flat or degenerate mesh): the queries run. */
+static int self_far_apart(const sem_collision_mesh *m, double radius)
+{
+    int n = m->n_points;
+    if (n <= 0) return 1;
+    double c[3] = {0, 0, 0}, c0[3] = {0, 0, 0}, A[9] = {0};
+    for (int p = 0; p < n; ++p)
+        for (int a = 0; a < 3; ++a) {
+            c[a] += m->x[3 * (size_t)p + a];
+            c0[a] += m->x0[3 * (size_t)p + a];
+        }
+    for (int a = 0; a < 3; ++a) {
+        c[a] /= n;
+        c0[a] /= n;
+    }
+    for (int p = 0; p < n; ++p)
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                A[3 * a + b] += (m->x[3 * (size_t)p + a] - c[a]) * (m->x0[3 * (size_t)p + b] - c0[b]);
+    double scale = 0;
+    for (int i = 0; i < 9; ++i) scale += A[i] * A[i];
+    scale = sqrt(scale / 3);
+    if (!(scale > 0) || !isfinite(scale)) return 0;
+    for (int i = 0; i < 9; ++i) A[i] /= scale;
+    for (int it = 0; it < 60; ++it) {
+        double det = det3(A);
+        if (!(fabs(det) > 1e-12) || !isfinite(det)) return 0;
+        /* inverse transpose = cofactor matrix / det */
+        double C[9] = {A[4] * A[8] - A[5] * A[7], A[5] * A[6] - A[3] * A[8], A[3] * A[7] - A[4] * A[6],
+                       A[2] * A[7] - A[1] * A[8], A[0] * A[8] - A[2] * A[6], A[1] * A[6] - A[0] * A[7],
+                       A[1] * A[5] - A[2] * A[4], A[2] * A[3] - A[0] * A[5], A[0] * A[4] - A[1] * A[3]};
+        double change = 0;
+        for (int i = 0; i < 9; ++i) {
+            double next = 0.5 * (A[i] + C[i] / det);
+            change += (next - A[i]) * (next - A[i]);
+            A[i] = next;
+        }
+        if (change < 1e-24) break;
+    }
+    /* rows made orthonormal (Gram-Schmidt) */
+    for (int r = 0; r < 3; ++r) {
+        double *row = A + 3 * r;
+        for (int q = 0; q < r; ++q) {
+            double d = dot3(row, A + 3 * q);
+            for (int k = 0; k < 3; ++k) row[k] -= d * A[3 * q + k];
+        }
+        double l = sqrt(dot3(row, row));
+        if (!(l > 0.5)) return 0;
+        for (int k = 0; k < 3; ++k) row[k] /= l;
+    }
+    double limit = 0.99 * 0.5 * (SELF_EXCLUSION - 1) * radius, limit2 = limit * limit;
+    for (int p = 0; p < n; ++p) {
+        const double *x = m->x + 3 * (size_t)p, *x0 = m->x0 + 3 * (size_t)p;
+        double r0[3] = {x0[0] - c0[0], x0[1] - c0[1], x0[2] - c0[2]}, e[3];
+        for (int a = 0; a < 3; ++a) e[a] = x[a] - c[a] - dot3(A + 3 * a, r0);
+        if (!(dot3(e, e) < limit2)) return 0;
+    }
+    return 1;
+}
+
 /* contact_object of each of the system's objects */
 static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err)
 {
@@ -397,7 +473,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         r.mu = sqrt(co->friction * col->friction);
         out[n++] = r;
     }
-    if (self_on(c)) {
+    if (self_on(c) && !co->self_far) {
         /* the object's own surface beyond the exclusion rule; within the search radius only
          * (self-contact needs no coupling blocks, the margin's only use) */
         self_exclusion ex = {m, m->x0 + 3 * (size_t)p, SELF_EXCLUSION * SELF_EXCLUSION * radius * radius};
@@ -460,6 +536,10 @@ static sem_status detect(sem_contact *c, const sem_system *s, const double *q, d
     for (int k = 0; k < s->n_objects; ++k)
         sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
     int per_point = c->n_colliders + s->n_objects - 1 + self_on(c);
+    for (int k = 0; k < s->n_objects && self_on(c); ++k) {
+        contact_object *co = &c->objects[c->sys_to_contact[k]];
+        co->self_far = self_far_apart(&co->mesh, co->thickness + SEARCH_DEPTH * co->length);
+    }
     if (per_point <= 0) return SEM_OK;
     int nthreads = s->n_objects > 0 ? s->objects[0]->nthreads : 1;
     for (int k = 0; k < s->n_objects; ++k) {
