@@ -125,7 +125,7 @@ static int default_quadrature(const sem_model *m, const sem_subray_settings *st,
     sem_error err;
     sem_discretization *d = calloc(1, sizeof *d);
     sem_raycast_scene *scene = NULL;
-    int ok = d && sem_step_sample(m, d, &err) == SEM_OK &&
+    int ok = d && sem_step_sample(m, 0, d, &err) == SEM_OK &&
              sem_raycast_scene_build(m, o.tessellation, &scene, &err) == SEM_OK &&
              sem_step_frame(scene, d, &err) == SEM_OK;
     *seconds = INFINITY;

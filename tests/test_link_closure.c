@@ -5,7 +5,11 @@
  * rule through `nm -A libsem.a` and checks that no member it reaches needs an Embree
  * (rtc*) or GLPK (glp_*) symbol: the simulator must not pull in the preprocessing
  * (preprocess.c drives the ray casting and the origins' min-cost flow). It failed when
- * the polynomial basis lived in preprocess.c (19 members, Embree and GLPK reached). */
+ * the polynomial basis lived in preprocess.c (19 members, Embree and GLPK reached).
+ * The same listing shows that no member calls an omp_set_* function: the library never
+ * changes OpenMP's settings for the whole process (a thread count travels as an argument to
+ * num_threads clauses, src/util/threads.h); it failed while preprocess.c called
+ * omp_set_num_threads for its `threads` option. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,6 +105,12 @@ int main(void)
     CHECK(ok && status == 0 && n_members > 0 && defined.n > 0, "nm -A %s failed (status %d)", lib, status);
     if (!ok || status != 0 || defined.n == 0) goto done;
     qsort(defined.v, defined.n, sizeof *defined.v, compare_symbol);
+
+    int setters = 0;
+    for (size_t i = 0; i < undefined.n; ++i)
+        if (strncmp(undefined.v[i].name, "omp_set_", 8) == 0 && setters++ < 5)
+            fprintf(stderr, "%s calls %s\n", members[undefined.v[i].member], undefined.v[i].name);
+    CHECK(setters == 0, "%d members of libsem.a change OpenMP's process-wide settings", setters);
 
     /* the closure from the world API */
     int linked[256] = {0}, queue[256], head = 0, tail = 0;

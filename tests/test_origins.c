@@ -421,7 +421,7 @@ static void test_shared_models(void)
         o.sparsity = 0.5; /* keep some weights sparse so groups are many */
         sem_discretization *d = calloc(1, sizeof *d);
         sem_raycast_scene *scene = NULL;
-        sem_status st = sem_step_sample(m, d, &err);
+        sem_status st = sem_step_sample(m, 0, d, &err);
         if (st == SEM_OK) st = sem_raycast_scene_build(m, o.tessellation, &scene, &err);
         if (st == SEM_OK) st = sem_step_quadrature(m, scene, &o, d, &err);
         double t0 = now();

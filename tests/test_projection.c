@@ -76,7 +76,7 @@ static sem_status make_disc(const sem_model *m, const int *part_origin, int orde
                             sem_discretization *d, sem_error *err)
 {
     memset(d, 0, sizeof *d);
-    sem_status st = sem_step_sample(m, d, err);
+    sem_status st = sem_step_sample(m, 0, d, err);
     if (st != SEM_OK) return st;
     d->order = order;
     d->part_origin = malloc((size_t)d->n_parts * sizeof(int));
@@ -689,7 +689,7 @@ static void test_shared_models(void)
                     sem_discretization d2;
                     memset(&d2, 0, sizeof d2);
                     double t0 = now();
-                    sem_step_sample(m, &d2, &err);
+                    sem_step_sample(m, 0, &d2, &err);
                     best_sample = fmin(best_sample, now() - t0);
                     free_disc(&d2);
                     sem_csr_free(&d.Pi);

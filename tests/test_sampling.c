@@ -101,7 +101,7 @@ static void test_box_area_and_counts(void)
     sem_discretization d;
     memset(&d, 0, sizeof d);
     sem_error err;
-    sem_status st = sem_step_sample(m, &d, &err);
+    sem_status st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_OK, "%s", err.message);
     if (st != SEM_OK) return;
     double exact = 2 * (size[0] * size[1] + size[1] * size[2] + size[2] * size[0]);
@@ -150,7 +150,7 @@ static void test_box_area_and_counts(void)
     sem_discretization d1;
     memset(&d1, 0, sizeof d1);
     omp_set_num_threads(1);
-    st = sem_step_sample(m, &d1, &err);
+    st = sem_step_sample(m, 0, &d1, &err);
     omp_set_num_threads(2);
     CHECK(st == SEM_OK, "%s", err.message);
     if (st == SEM_OK) {
@@ -176,7 +176,7 @@ static void test_low_degree_counts(void)
     sem_discretization d;
     memset(&d, 0, sizeof d);
     sem_error err;
-    sem_status st = sem_step_sample(m, &d, &err);
+    sem_status st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_OK, "%s", err.message);
     if (st == SEM_OK) {
         CHECK(d.n_samples == 3 * 4 * 4, "n_samples %d", d.n_samples);
@@ -243,7 +243,7 @@ static void test_sphere_and_cylinder_area(void)
     CHECK(sem_primitive_sphere(m, &sd, &err) == SEM_OK, "%s", err.message);
     sem_discretization d;
     memset(&d, 0, sizeof d);
-    sem_status st = sem_step_sample(m, &d, &err);
+    sem_status st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_OK, "%s", err.message);
     double exact = 4 * M_PI * sd.radius * sd.radius;
     if (st == SEM_OK) {
@@ -278,7 +278,7 @@ static void test_sphere_and_cylinder_area(void)
         }
         m = sphere_model(sd.radius, n_u, n_v);
         memset(&d, 0, sizeof d);
-        st = sem_step_sample(m, &d, &err);
+        st = sem_step_sample(m, 0, &d, &err);
         CHECK(st == SEM_OK, "%s", err.message);
         if (st == SEM_OK) {
             double rel = fabs(total_area(&d) - exact) / exact;
@@ -299,7 +299,7 @@ static void test_sphere_and_cylinder_area(void)
     sem_cylinder_def cd = sem_default_cylinder_def();
     CHECK(sem_primitive_cylinder(m, &cd, &err) == SEM_OK, "%s", err.message);
     memset(&d, 0, sizeof d);
-    st = sem_step_sample(m, &d, &err);
+    st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_OK, "%s", err.message);
     if (st == SEM_OK) {
         exact = 2 * M_PI * cd.radius * cd.height + 2 * M_PI * cd.radius * cd.radius;
@@ -357,9 +357,9 @@ static void test_trimmed_square(void)
     sem_discretization d, df;
     memset(&d, 0, sizeof d);
     memset(&df, 0, sizeof df);
-    sem_status st = sem_step_sample(m, &d, &err);
+    sem_status st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_OK, "%s", err.message);
-    CHECK(sem_step_sample(full, &df, &err) == SEM_OK, "%s", err.message);
+    CHECK(sem_step_sample(full, 0, &df, &err) == SEM_OK, "%s", err.message);
     if (st == SEM_OK) {
         double exact = 4.0 - M_PI * 0.25;
         double got = total_area(&d);
@@ -402,7 +402,7 @@ static void test_errors(void)
     sem_discretization d;
     memset(&d, 0, sizeof d);
     sem_error err;
-    CHECK(sem_step_sample(m, &d, &err) == SEM_ERR_INVALID, "no parts");
+    CHECK(sem_step_sample(m, 0, &d, &err) == SEM_ERR_INVALID, "no parts");
     CHECK(strstr(err.message, "empty model") != NULL, "message: %s", err.message);
 
     /* a hole bigger than the domain removes every sample */
@@ -411,7 +411,7 @@ static void test_errors(void)
     planar_part(&part, o, e1, e2, 2, 2, 2);
     add_hole(&part, 0.5, 0.5, 5.0);
     sem_model_take_part(m, &part, NULL);
-    sem_status st = sem_step_sample(m, &d, &err);
+    sem_status st = sem_step_sample(m, 0, &d, &err);
     CHECK(st != SEM_OK, "everything trimmed away must fail");
     if (st == SEM_OK) discretization_free(&d);
     else CHECK(strstr(err.message, "empty model") != NULL || strstr(err.message, "part 0") != NULL,
@@ -426,7 +426,7 @@ static void test_errors(void)
     part.surface.ctrl[4] = NAN;
     sem_model_take_part(m, &part, NULL);
     memset(&d, 0, sizeof d);
-    st = sem_step_sample(m, &d, &err);
+    st = sem_step_sample(m, 0, &d, &err);
     CHECK(st == SEM_ERR_INVALID, "NaN control point: status %d", (int)st);
     CHECK(strstr(err.message, "part 1") != NULL, "message: %s", err.message);
     CHECK(d.sample_X == NULL && d.J_hat.row_start == NULL, "nothing filled on failure");
@@ -450,7 +450,7 @@ static void test_seam_weights(void)
         const sem_model *m = r ? fine : box;
         sem_discretization d;
         memset(&d, 0, sizeof d);
-        CHECK(sem_step_sample(m, &d, &err) == SEM_OK, "%s", err.message);
+        CHECK(sem_step_sample(m, 0, &d, &err) == SEM_OK, "%s", err.message);
         int bad = 0, sides[3] = {0, 0, 0};
         double seam_side = 0, area_side = 0;
         for (int k = 0; k < d.n_samples; ++k) {

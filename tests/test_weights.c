@@ -415,7 +415,7 @@ static void test_shared_beam(void)
     o.rays[0] = o.rays[1] = 3;
     o.points_per_interval = 15;
     sem_discretization *d = calloc(1, sizeof *d);
-    sem_status st = sem_step_sample(m, d, &err);
+    sem_status st = sem_step_sample(m, 0, d, &err);
     if (st == SEM_OK) st = sem_step_quadrature(m, scene, &o, d, &err);
     if (st == SEM_OK) st = sem_step_weights(m, scene, &o, d, &err);
     CHECK(st == SEM_OK, "beam steps: %s", err.message);

@@ -8,6 +8,8 @@
 #ifndef SEM_STATUS_H
 #define SEM_STATUS_H
 
+#include <stdarg.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -31,6 +33,16 @@ typedef struct sem_error {
 sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* The va_list form, for functions that add their own place to a message: sets err (if
+ * non-NULL) to "PREFIX: message" ("message" when prefix is NULL or empty) and returns status.
+ * The readers' "FILE:LINE: what is wrong" and the scene's "NAME: KEY: what is wrong" go
+ * through it. */
+sem_status sem_error_vset(sem_error *err, sem_status status, const char *prefix, const char *fmt,
+                          va_list ap)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 0)))
 #endif
     ;
 void sem_error_clear(sem_error *err);

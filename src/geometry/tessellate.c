@@ -19,7 +19,9 @@
 
 #include "sem/nurbs.h"
 #include "sem/trim.h"
+#include "geometry/tessellate_threads.h"
 #include "util/free_all.h"
+#include "util/threads.h"
 
 typedef struct part_template {
     int first_vertex, n_vertices;
@@ -39,6 +41,7 @@ struct sem_mesh_template {
     int *triangle_part;
     int *basis_index;    /* control point index within the part */
     double *phi, *phi_u, *phi_v;
+    int threads;         /* of the parallel loops over parts and vertices (0: OpenMP's default) */
 };
 
 void sem_mesh_template_destroy(sem_mesh_template *t)
@@ -252,12 +255,12 @@ static void vertex_frame(const sem_surface *s, int n_basis, const int *index, co
 
 /* Topology of every part, in parallel over parts; first error in part order. */
 static sem_status build_topologies(const sem_model *model, int resolution, int covering,
-                                   part_topology **out, sem_error *err)
+                                   int threads, part_topology **out, sem_error *err)
 {
     int n_parts = model->n_parts;
     part_topology *tp = calloc((size_t)(n_parts > 0 ? n_parts : 1), sizeof *tp);
     if (!tp) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
-#pragma omp parallel for schedule(dynamic, 1) if (n_parts > 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(sem_threads(threads)) if (n_parts > 1)
     for (int i = 0; i < n_parts; ++i)
         part_topology_build(&model->parts[i], i, resolution, covering, &tp[i]);
     for (int i = 0; i < n_parts; ++i)
@@ -381,14 +384,15 @@ static sem_status evaluate_parts(const sem_mesh_template *t, const sem_model *mo
                                  const part_topology *tp, sem_mesh *m, sem_error *err)
 {
     int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (t->n_parts > 1)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) \
+    num_threads(sem_threads(t->threads)) if (t->n_parts > 1)
     for (int i = 0; i < t->n_parts; ++i)
         if (!evaluate_part(t, model, i, &tp[i], m)) failed |= 1;
     if (failed) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     return SEM_OK;
 }
 
-static sem_status check_model(const sem_model *model, int resolution, sem_error *err)
+static sem_status check_tessellation_input(const sem_model *model, int resolution, sem_error *err)
 {
     if (!model) return sem_error_set(err, SEM_ERR_INVALID, "tessellation: NULL model");
     if (resolution < 1 || resolution > 4096)
@@ -406,22 +410,23 @@ static sem_status check_model(const sem_model *model, int resolution, sem_error 
 /* Template topology (and, unless skip_basis, its basis rows); *tp_out keeps the part
  * topologies when non-NULL. */
 static sem_status template_build(const sem_model *model, int resolution, int skip_basis,
-                                 int covering, sem_mesh_template **out, part_topology **tp_out,
-                                 sem_error *err)
+                                 int covering, int threads, sem_mesh_template **out,
+                                 part_topology **tp_out, sem_error *err)
 {
     *out = NULL;
-    sem_status st = check_model(model, resolution, err);
+    sem_status st = check_tessellation_input(model, resolution, err);
     if (st != SEM_OK) return st;
     sem_mesh_template *t = calloc(1, sizeof *t);
     if (!t) return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     t->n_parts = model->n_parts;
+    t->threads = threads;
     t->parts = calloc((size_t)(model->n_parts > 0 ? model->n_parts : 1), sizeof *t->parts);
     if (!t->parts) {
         sem_mesh_template_destroy(t);
         return sem_error_set(err, SEM_ERR_NOMEM, "tessellation: out of memory");
     }
     part_topology *tp = NULL;
-    st = build_topologies(model, resolution, covering, &tp, err);
+    st = build_topologies(model, resolution, covering, threads, &tp, err);
     if (st == SEM_OK) st = place_topologies(t, model, tp, err);
     if (st == SEM_OK && !skip_basis) {
         size_t nbasis = 0;
@@ -452,13 +457,13 @@ static sem_status template_build(const sem_model *model, int resolution, int ski
 sem_status sem_mesh_template_build(const sem_model *model, int resolution,
                                    sem_mesh_template **out, sem_error *err)
 {
-    return template_build(model, resolution, 0, 0, out, NULL, err);
+    return template_build(model, resolution, 0, 0, 0, out, NULL, err);
 }
 
 sem_status sem_mesh_template_build_covering(const sem_model *model, int resolution,
                                             sem_mesh_template **out, sem_error *err)
 {
-    return template_build(model, resolution, 0, 1, out, NULL, err);
+    return template_build(model, resolution, 0, 1, 0, out, NULL, err);
 }
 
 void sem_mesh_free(sem_mesh *m)
@@ -520,7 +525,7 @@ sem_status sem_mesh_update(const sem_mesh_template *t, const sem_model *model, s
                                  i);
     }
     const int n = t->n_vertices;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(sem_threads(t->threads))
     for (int vtx = 0; vtx < n; ++vtx) {
         int p = t->vertex_part[vtx];
         const part_template *pt = &t->parts[p];
@@ -536,13 +541,19 @@ sem_status sem_mesh_update(const sem_mesh_template *t, const sem_model *model, s
 sem_status sem_mesh_from_model(const sem_model *model, int resolution, sem_mesh *out,
                                sem_error *err)
 {
+    return sem_mesh_from_model_threads(model, resolution, 0, out, err);
+}
+
+sem_status sem_mesh_from_model_threads(const sem_model *model, int resolution, int threads,
+                                       sem_mesh *out, sem_error *err)
+{
     /* topology only, then positions and normals straight from cached direction bases:
      * the template's basis rows are never stored (same arithmetic as template + update,
      * so the result is bitwise the same) */
     memset(out, 0, sizeof *out);
     sem_mesh_template *t;
     part_topology *tp = NULL;
-    sem_status st = template_build(model, resolution, 1, 0, &t, &tp, err);
+    sem_status st = template_build(model, resolution, 1, 0, threads, &t, &tp, err);
     if (st != SEM_OK) return st;
     st = sem_mesh_template_mesh(t, out, err);
     if (st == SEM_OK) st = evaluate_parts(t, model, tp, out, err);

@@ -45,24 +45,26 @@ static sem_status parse_error(iges_reader *r, int line, const char *fmt, ...)
     ;
 static sem_status parse_error(iges_reader *r, int line, const char *fmt, ...)
 {
-    char msg[768];
+    char place[1024];
+    snprintf(place, sizeof place, "%s:%d", r->name, line);
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sem_status st = sem_error_vset(r->err, SEM_ERR_PARSE, place, fmt, ap);
     va_end(ap);
-    return sem_error_set(r->err, SEM_ERR_PARSE, "%s:%d: %s", r->name, line, msg);
+    return st;
 }
 
 sem_status iges_entity_error(iges_reader *r, int idx, int line, const char *fmt, ...)
 {
-    char msg[640];
+    const iges_entry *e = &r->entries[idx];
+    char place[1024];
+    snprintf(place, sizeof place, "%s:%d: entity %d (DE %d)", r->name, line > 0 ? line : e->line,
+             e->type, iges_de_number(idx));
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sem_status st = sem_error_vset(r->err, SEM_ERR_PARSE, place, fmt, ap);
     va_end(ap);
-    const iges_entry *e = &r->entries[idx];
-    return sem_error_set(r->err, SEM_ERR_PARSE, "%s:%d: entity %d (DE %d): %s", r->name,
-                         line > 0 ? line : e->line, e->type, iges_de_number(idx), msg);
+    return st;
 }
 
 sem_status iges_nomem(iges_reader *r)

@@ -135,12 +135,13 @@ static sem_status parse_error(obj_reader *r, sem_status st, const char *fmt, ...
 
 static sem_status parse_error(obj_reader *r, sem_status st, const char *fmt, ...)
 {
-    char msg[900];
+    char place[1024];
+    snprintf(place, sizeof place, "%s:%d", r->path, r->line);
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sem_status status = sem_error_vset(r->err, st, place, fmt, ap);
     va_end(ap);
-    return sem_error_set(r->err, st, "%s:%d: %s", r->path, r->line, msg);
+    return status;
 }
 
 static sem_status no_memory(obj_reader *r)

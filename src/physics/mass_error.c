@@ -36,7 +36,7 @@ static sem_status setup_points(sem_object *o, sem_error *err)
     }
     o->point_pairs = malloc((n_pp + 1) * sizeof(int));
     if (!o->point_pairs) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
     for (int p = 0; p < o->n_quad; ++p) {
         const double *X = d->quad_X + 3 * (size_t)p;
         int r0 = W->row_start[p], r1 = W->row_start[p + 1];

@@ -103,7 +103,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
         free(rows);
         return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for the error matrix's samples");
     }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(o->nthreads)
     for (int t = 0; t < ns; ++t) {
         int r = rows[t].sample;
         size_t len = (size_t)(J->row_start[r + 1] - J->row_start[r]);

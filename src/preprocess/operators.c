@@ -40,6 +40,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/threads.h"
 
 /* ------------------------------------------------------------------------------------ */
 /* sparse helpers                                                                        */
@@ -71,7 +72,7 @@ static int row_lower_bound(const sem_csr *B, int a, int c)
  * the entries with column >= row are formed: the upper triangle of a product known to be
  * symmetric (Eq. 14, 16), half the work. */
 static sem_status csr_product_ex(const sem_csr *A, const sem_csr *B, sem_csr *C, int count_only,
-                                 size_t *nnz_out, int upper_only)
+                                 size_t *nnz_out, int upper_only, int threads)
 {
     const int n_rows = A->n_rows, n_cols = B->n_cols;
     int *count = calloc((size_t)n_rows + 1, sizeof(int));
@@ -84,7 +85,7 @@ static sem_status csr_product_ex(const sem_csr *A, const sem_csr *B, sem_csr *C,
     for (size_t k = 0; k < sem_csr_nnz(A); ++k)
         work += (size_t)(B->row_start[A->col[k] + 1] - B->row_start[A->col[k]]);
     const int parallel = work > PARALLEL_WORK;
-#pragma omp parallel if (parallel) reduction(| : failed)
+#pragma omp parallel num_threads(threads) if (parallel) reduction(| : failed)
     {
         int *mark = malloc((size_t)(n_cols > 0 ? n_cols : 1) * sizeof(int));
         if (!mark) failed = 1;
@@ -130,7 +131,7 @@ static sem_status csr_product_ex(const sem_csr *A, const sem_csr *B, sem_csr *C,
     }
     memcpy(C->row_start, count, ((size_t)n_rows + 1) * sizeof(int));
     free(count);
-#pragma omp parallel if (parallel) reduction(| : failed)
+#pragma omp parallel num_threads(threads) if (parallel) reduction(| : failed)
     {
         int *mark = malloc((size_t)(n_cols > 0 ? n_cols : 1) * sizeof(int));
         double *acc = malloc((size_t)(n_cols > 0 ? n_cols : 1) * sizeof(double));
@@ -179,9 +180,9 @@ static sem_status csr_product_ex(const sem_csr *A, const sem_csr *B, sem_csr *C,
 }
 
 static sem_status csr_product(const sem_csr *A, const sem_csr *B, sem_csr *C, int count_only,
-                              size_t *nnz_out)
+                              size_t *nnz_out, int threads)
 {
-    return csr_product_ex(A, B, C, count_only, nnz_out, 0);
+    return csr_product_ex(A, B, C, count_only, nnz_out, 0, threads);
 }
 
 /* T = A^T with entry (r, c) of A multiplied by row_scale[r] (NULL: 1). Serial counting
@@ -284,7 +285,7 @@ static sem_status csr_mirror_upper(sem_csr *U)
  * the stiffness pattern: the constant has no gradient). Row p*rows + e holds, for each part
  * i of Wt row p in order, the m (or m - 1) consecutive columns i*m + k: sorted. */
 static sem_status build_poly_rows(const sem_discretization *d, const sem_csr *Wt, const double *X,
-                                  int rows_per_point, int skip_constant, sem_csr *G)
+                                  int rows_per_point, int skip_constant, int threads, sem_csr *G)
 {
     const int m = d->n_basis, n = Wt->n_rows;
     const int k0 = skip_constant ? 1 : 0, per_part = m - k0;
@@ -298,7 +299,7 @@ static sem_status build_poly_rows(const sem_discretization *d, const sem_csr *Wt
             G->row_start[row + 1] = G->row_start[row] + cnt;
         }
     }
-#pragma omp parallel for schedule(static) if (nnz > PARALLEL_WORK)
+#pragma omp parallel for schedule(static) num_threads(threads) if (nnz > PARALLEL_WORK)
     for (int p = 0; p < n; ++p) {
         double b[10], db[30];
         for (int e = 0; e < rows_per_point; ++e) {
@@ -458,6 +459,7 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
     sem_csr GstA = {0}, Hs = {0}, K = {0}, HsPi = {0}, X = {0}, M1 = {0}, KT = {0}, KtPi = {0};
     sem_csr JtA = {0}, JAJ = {0}, tmp = {0}, U = {0}, UT = {0}, S = {0}, Pi1 = {0}, Pi1T = {0};
     sem_csr SPi = {0};
+    const int threads = sem_threads(o ? o->threads : 0);
     st = SEM_OK;
 
 #define TRY(call)                                                                          \
@@ -469,8 +471,8 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
     } while (0)
 
     /* Eq. 12-13 */
-    TRY(build_poly_rows(d, &d->W, d->quad_X, 1, 0, &G));
-    TRY(csr_product(&G, &d->Pi, &d->Gamma, 0, NULL));
+    TRY(build_poly_rows(d, &d->W, d->quad_X, 1, 0, threads, &G));
+    TRY(csr_product(&G, &d->Pi, &d->Gamma, 0, NULL, threads));
     if (!o || !o->q_space_operators) {
         /* Gamma only: the rest are dense blocks over control points that the structured
          * solver never forms (physics/structured.h); they stay empty, with their rows */
@@ -486,34 +488,34 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
      * they are the largest operator (3 rows per point: 1.7 GB of a 11,439-dof CAD part's
      * 2.4 GB) */
     if (o->q_space_operators >= 2) {
-        TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 0, &Gd));
-        TRY(csr_product(&Gd, &d->Pi, &d->Grad, 0, NULL));
+        TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 0, threads, &Gd));
+        TRY(csr_product(&Gd, &d->Pi, &d->Grad, 0, NULL, threads));
     } else {
         TRY(empty_rows(&d->Grad, 3 * d->n_quad, d->n_ctrl));
     }
-    TRY(build_poly_rows(d, &d->W_samples, d->sample_X, 1, 0, &Gs));
-    TRY(csr_product(&Gs, &d->Pi, &d->Gamma_samples, 0, NULL));
+    TRY(build_poly_rows(d, &d->W_samples, d->sample_X, 1, 0, threads, &Gs));
+    TRY(csr_product(&Gs, &d->Pi, &d->Gamma_samples, 0, NULL, threads));
 
     /* Eq. 14: M = Pi^T (G^T V G) Pi, unit density */
     TRY(csr_transpose(&d->Pi, NULL, &PiT));
     TRY(csr_transpose(&G, d->quad_volume, &GtV));
-    TRY(csr_product(&GtV, &G, &H, 0, NULL));
-    TRY(csr_product(&H, &d->Pi, &HPi, 0, NULL));
-    TRY(csr_product_ex(&PiT, &HPi, &d->M, 0, NULL, 1));
+    TRY(csr_product(&GtV, &G, &H, 0, NULL, threads));
+    TRY(csr_product(&H, &d->Pi, &HPi, 0, NULL, threads));
+    TRY(csr_product_ex(&PiT, &HPi, &d->M, 0, NULL, 1, threads));
     TRY(csr_mirror_upper(&d->M));
 
     /* Eq. 16: M_eps = Pi^T (Hs Pi - K) - K^T Pi + J^T A J */
     TRY(csr_transpose(&Gs, d->sample_area, &GstA));
-    TRY(csr_product(&GstA, &Gs, &Hs, 0, NULL));
-    TRY(csr_product(&GstA, &d->J_hat, &K, 0, NULL));
-    TRY(csr_product(&Hs, &d->Pi, &HsPi, 0, NULL));
+    TRY(csr_product(&GstA, &Gs, &Hs, 0, NULL, threads));
+    TRY(csr_product(&GstA, &d->J_hat, &K, 0, NULL, threads));
+    TRY(csr_product(&Hs, &d->Pi, &HsPi, 0, NULL, threads));
     TRY(csr_add(&HsPi, 1.0, &K, -1.0, &X));
     /* M_eps is symmetric, so the upper triangles of its three terms define it */
-    TRY(csr_product_ex(&PiT, &X, &M1, 0, NULL, 1));
+    TRY(csr_product_ex(&PiT, &X, &M1, 0, NULL, 1, threads));
     TRY(csr_transpose(&K, NULL, &KT));
-    TRY(csr_product_ex(&KT, &d->Pi, &KtPi, 0, NULL, 1));
+    TRY(csr_product_ex(&KT, &d->Pi, &KtPi, 0, NULL, 1, threads));
     TRY(csr_transpose(&d->J_hat, d->sample_area, &JtA));
-    TRY(csr_product_ex(&JtA, &d->J_hat, &JAJ, 0, NULL, 1));
+    TRY(csr_product_ex(&JtA, &d->J_hat, &JAJ, 0, NULL, 1, threads));
     TRY(csr_add(&M1, 1.0, &KtPi, -1.0, &tmp));
     TRY(csr_add(&tmp, 1.0, &JAJ, 1.0, &d->M_eps));
     TRY(csr_mirror_upper(&d->M_eps));
@@ -526,16 +528,16 @@ sem_status sem_step_operators(const sem_preprocess_options *o, sem_discretizatio
             100.0 * (double)sem_csr_nnz(&d->M) / ((double)d->n_ctrl * (double)d->n_ctrl);
     } else {
         sem_csr_free(&Gd);
-        TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 1, &Gd));
+        TRY(build_poly_rows(d, &d->W, d->quad_X, 3, 1, threads, &Gd));
         TRY(union_rows_of_points(&Gd, 3, &U));
         TRY(csr_transpose(&U, NULL, &UT));
-        TRY(csr_product(&UT, &U, &S, 0, NULL));
+        TRY(csr_product(&UT, &U, &S, 0, NULL, threads));
         TRY(sem_csr_copy(&Pi1, &d->Pi));
         set_all_ones(&Pi1);
         TRY(csr_transpose(&Pi1, NULL, &Pi1T));
-        TRY(csr_product(&S, &Pi1, &SPi, 0, NULL));
+        TRY(csr_product(&S, &Pi1, &SPi, 0, NULL, threads));
         size_t nnz = 0;
-        TRY(csr_product(&Pi1T, &SPi, NULL, 1, &nnz));
+        TRY(csr_product(&Pi1T, &SPi, NULL, 1, &nnz, threads));
         d->stiffness_nnz_percent = 100.0 * (double)nnz / ((double)d->n_ctrl * (double)d->n_ctrl);
     }
 

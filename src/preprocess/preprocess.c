@@ -441,9 +441,6 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     st = check_sizes(model, &o, err);
     if (st != SEM_OK) return st;
 
-    int saved_threads = omp_get_max_threads();
-    if (o.threads > 0) omp_set_num_threads(o.threads);
-
     sem_discretization *d = calloc(1, sizeof *d);
     sem_raycast_scene *scene = NULL;
     if (!d) {
@@ -458,12 +455,12 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
     d->shared_fit = sem_preprocess_shared_fit(model, &o);
 
     double t0 = omp_get_wtime();
-    st = sem_step_sample(model, d, err);
+    st = sem_step_sample(model, o.threads, d, err);
     if (st != SEM_OK) goto done;
     double t1 = omp_get_wtime();
     d->timings.sample_s = t1 - t0;
 
-    st = sem_raycast_scene_build(model, o.tessellation, &scene, err);
+    st = sem_raycast_scene_build_threads(model, o.tessellation, o.threads, &scene, err);
     if (st != SEM_OK) goto done;
     /* the object's frame (principal axes of the surface) belongs to the shared setup: the
      * quadrature cells and the default alpha and gamma lengths are measured in it */
@@ -511,7 +508,6 @@ sem_status sem_preprocess(const sem_model *model, const sem_preprocess_options *
 
 done:
     sem_raycast_scene_destroy(scene);
-    if (o.threads > 0) omp_set_num_threads(saved_threads);
     if (st != SEM_OK) {
         sem_discretization_destroy(d);
         return st;

@@ -67,6 +67,7 @@
 
 #include "steps.h"
 #include "util/free_all.h"
+#include "util/threads.h"
 
 /* Relative eigenvalue threshold below which a fit direction counts as undetermined. */
 #define SEM_PROJECTION_NULL_TOL 1e-8
@@ -624,9 +625,10 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
     /* Threads only pay off for large inputs: small models (most of Table 1) take well under
      * a millisecond, less than a fork/join on a busy machine. */
     const int parallel = d->n_samples > 20000 || nnz > 200000;
+    const int threads = sem_threads(o ? o->threads : 0);
 
     /* rest moments -> length scale L_j and the origin consistency check */
-#pragma omp parallel for schedule(dynamic, 4) if (parallel)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (parallel)
     for (int i = 0; i < n_parts; ++i) part_rest_moments(&cx, i);
     for (int j = 0; j < n_origins; ++j) {
         group *g = &cx.groups[j];
@@ -668,7 +670,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
         if (!ps->T || !ps->S1 || (order == 2 && !ps->S2)) goto nomem;
     }
     for (int j = 0; j < n_origins; ++j) decide_floored(&cx, j);
-#pragma omp parallel for schedule(dynamic, 4) if (parallel)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads) if (parallel)
     for (int i = 0; i < n_parts; ++i) part_fit_moments(&cx, i);
     for (int j = 0; j < n_origins; ++j)
         if (group_sums(&cx, j) != SEM_OK) goto nomem;
@@ -681,7 +683,7 @@ sem_status sem_step_projection(const sem_preprocess_options *o, sem_discretizati
             Pi.row_start[row + 1] = Pi.row_start[row] + cx.groups[d->part_origin[i]].n_cols;
         }
     int failed = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) if (parallel)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(threads) if (parallel)
     for (int i = 0; i < n_parts; ++i)
         if (part_solve(&cx, i, &Pi, group_cols + group_cols_start[d->part_origin[i]]) != SEM_OK)
             failed = 1;

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "steps.h"
+#include "util/threads.h"
 
 /* Automatic spacing of the object-frame grid (see the file comment): at most the thinnest
  * extent / CELLS_THINNEST and the median part size / CELLS_PER_PART; at least what keeps the
@@ -210,7 +211,7 @@ sem_status sem_step_quadrature_with(const sem_model *model, const sem_raycast_sc
     if (g.cell_size > 0) {
         /* the object-frame grid of cells (quadrature_cells.c): points per column */
         sem_status cst = sem_quadrature_cells(model, scene, g.cell_size, settings, d, &rays,
-                                              &n_rays, n_rays_cast, err);
+                                              &n_rays, n_rays_cast, o->threads, err);
         if (cst != SEM_OK) {
             for (int r = 0; rays && r < n_rays; r++) {
                 free(rays[r].X);
@@ -226,7 +227,8 @@ sem_status sem_step_quadrature_with(const sem_model *model, const sem_raycast_sc
         if (!rays) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     /* a ray costs 5-20 us (exact hit refinement, winding-number vetoes), so even the
      * authors' small grids (81-180 rays) gain from a second thread: tire 1.1 -> 0.5 ms */
-#pragma omp parallel for schedule(dynamic, 4) reduction(| : failed) if (n_rays >= 16)
+#pragma omp parallel for schedule(dynamic, 4) reduction(| : failed) \
+    num_threads(sem_threads(o->threads)) if (n_rays >= 16)
     for (int r = 0; r < n_rays; r++) {
         int i = r % n1, j = r / n1;
         double s0 = g.lo[0] - pad, s1 = g.lo[1] + (i + 0.5) * (wb / n1),

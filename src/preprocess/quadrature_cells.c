@@ -42,6 +42,7 @@
 #include "quadrature_subrays.h"
 #include "util/free_all.h"
 #include "util/grow.h"
+#include "util/threads.h"
 
 #define SUBRAYS 4            /* rays per finest cell per direction */
 #define SMALL_PART_CELLS 3.0 /* a part asks for cells of at most its size / this */
@@ -402,7 +403,7 @@ static double refine(const sem_discretization *d, cell_grid *g, int max_level)
 sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene *scene, double h,
                                 const sem_subray_settings *settings, sem_discretization *d,
                                 sem_ray_points **columns_out, int *n_columns_out,
-                                long long *n_rays, sem_error *err)
+                                long long *n_rays, int threads, sem_error *err)
 {
     if (n_rays) *n_rays = 0;
     *columns_out = NULL;
@@ -466,7 +467,8 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
     }
     sem_subray_column *rays = NULL;
     sem_subray_settings defaults = sem_subray_default_settings();
-    sem_status rst = sem_subrays_cast(scene, &rg, base, settings ? settings : &defaults, &rays, err);
+    sem_status rst = sem_subrays_cast(scene, &rg, base, settings ? settings : &defaults, threads,
+                                      &rays, err);
     free(base);
     if (rst != SEM_OK) {
         free(cols);
@@ -474,7 +476,7 @@ sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene 
         return rst;
     }
     int failed = 0;
-#pragma omp parallel reduction(| : failed)
+#pragma omp parallel num_threads(sem_threads(threads)) reduction(| : failed)
     {
         column_buffers b;
         memset(&b, 0, sizeof b);

@@ -62,6 +62,7 @@
 #include <string.h>
 
 #include "util/grow.h"
+#include "util/threads.h"
 
 /* Levels of quarters below the base squares. */
 #define MAX_DEPTH 2
@@ -220,16 +221,17 @@ void sem_subrays_free(sem_subray_column *columns, int n_columns)
 }
 
 sem_status sem_subrays_cast(const sem_raycast_scene *scene, const sem_subray_grid *g,
-                            const int *base, const sem_subray_settings *st,
+                            const int *base, const sem_subray_settings *st, int threads,
                             sem_subray_column **columns_out, sem_error *err)
 {
+    const int n_threads = sem_threads(threads);
     *columns_out = NULL;
     const int n_columns = g->n[1] * g->n[2];
     sem_subray_column *cols = calloc((size_t)(n_columns > 0 ? n_columns : 1), sizeof *cols);
     if (!cols) return sem_error_set(err, SEM_ERR_NOMEM, "quadrature: out of memory");
     int failed = 0;
     /* level 0: the base squares */
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(n_threads)
     for (int c = 0; c < n_columns; ++c) {
         sem_subray_column *col = &cols[c];
         const int S = base[c];
@@ -252,7 +254,7 @@ sem_status sem_subrays_cast(const sem_raycast_scene *scene, const sem_subray_gri
     if (!split) failed = 1;
     for (int level = 0; level < depth && !failed; ++level) {
         /* judge every square of this level, then split: the judgement reads neighbours only */
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(n_threads)
         for (int c = 0; c < n_columns; ++c) {
             const sem_subray_column *col = &cols[c];
             const int m = col->level_end - col->level_begin;
@@ -270,7 +272,7 @@ sem_status sem_subrays_cast(const sem_raycast_scene *scene, const sem_subray_gri
                                                        col->level_begin + k);
         }
         if (failed) break;
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(n_threads)
         for (int c = 0; c < n_columns; ++c) {
             sem_subray_column *col = &cols[c];
             const int begin = col->level_begin, end = col->level_end;

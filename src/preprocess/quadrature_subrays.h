@@ -52,7 +52,7 @@ typedef struct sem_subray_column {
  * refined where the inside length is not smooth (see quadrature_subrays.c). *columns gets
  * n[1] n[2] columns (free with sem_subrays_free). */
 sem_status sem_subrays_cast(const sem_raycast_scene *scene, const sem_subray_grid *grid,
-                            const int *base, const sem_subray_settings *settings,
+                            const int *base, const sem_subray_settings *settings, int threads,
                             sem_subray_column **columns, sem_error *err);
 void sem_subrays_free(sem_subray_column *columns, int n_columns);
 

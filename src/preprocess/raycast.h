@@ -35,6 +35,9 @@ typedef struct sem_ray_hit {
 /* Builds the scene from a tessellation with `resolution` cells per knot span. */
 sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                                    sem_raycast_scene **out, sem_error *err);
+/* The same on `threads` threads (0: OpenMP's default); the same scene on any count. */
+sem_status sem_raycast_scene_build_threads(const sem_model *model, int resolution, int threads,
+                                           sem_raycast_scene **out, sem_error *err);
 void sem_raycast_scene_destroy(sem_raycast_scene *scene);
 
 /* First hit from origin along unit direction dir for t in (t_near, t_far); returns 1 when

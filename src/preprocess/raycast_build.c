@@ -23,6 +23,8 @@
 
 #include "sem/nurbs.h"
 #include "sem/tessellate.h"
+#include "geometry/tessellate_threads.h"
+#include "util/threads.h"
 
 static void raw_mesh_free(raw_mesh *m)
 {
@@ -35,13 +37,13 @@ static void raw_mesh_free(raw_mesh *m)
 
 /* The shared tessellation (sem/tessellate.h): trimmed parts keep the triangles whose (u,v)
  * centroid is inside the trim. */
-static sem_status tessellate(const sem_model *model, int resolution, raw_mesh *out,
-                             sem_error *err)
+static sem_status tessellate(const sem_model *model, int resolution, int threads,
+                             raw_mesh *out, sem_error *err)
 {
     memset(out, 0, sizeof *out);
     sem_mesh mesh;
     memset(&mesh, 0, sizeof mesh);
-    sem_status st = sem_mesh_from_model(model, resolution, &mesh, err);
+    sem_status st = sem_mesh_from_model_threads(model, resolution, threads, &mesh, err);
     if (st != SEM_OK) {
         sem_mesh_free(&mesh);
         return st;
@@ -75,6 +77,12 @@ static void embree_error(void *user, enum RTCError code, const char *str)
 sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                                    sem_raycast_scene **out, sem_error *err)
 {
+    return sem_raycast_scene_build_threads(model, resolution, 0, out, err);
+}
+
+sem_status sem_raycast_scene_build_threads(const sem_model *model, int resolution, int threads,
+                                           sem_raycast_scene **out, sem_error *err)
+{
     if (!out) return sem_error_set(err, SEM_ERR_INVALID, "raycast: NULL output");
     *out = NULL;
     if (!model || model->n_parts <= 0)
@@ -84,7 +92,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
                              resolution);
 
     raw_mesh mesh_data, *mesh = &mesh_data;
-    sem_status st = tessellate(model, resolution, mesh, err);
+    sem_status st = tessellate(model, resolution, threads, mesh, err);
     if (st != SEM_OK) return st;
 
     sem_raycast_scene *s = calloc(1, sizeof *s);
@@ -278,7 +286,7 @@ sem_status sem_raycast_scene_build(const sem_model *model, int resolution,
     }
     free(bsamples);
     free(n_bsamples);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(sem_threads(threads))
     for (int p = 0; p < n_parts; p++) sign[p] = sem_raycast_estimate_part_sign(s, component, p);
     memcpy(s->part_sign, sign, (size_t)n_parts * sizeof *sign);
     free(sign);

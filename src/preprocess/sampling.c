@@ -40,6 +40,7 @@
 #include "sem/trim.h"
 #include "steps.h"
 #include "util/free_all.h"
+#include "util/threads.h"
 
 /* Relative shift of a trim test point towards its span centre (see the opening comment). */
 #define SEM_TRIM_NUDGE 1e-9
@@ -232,7 +233,8 @@ done:
     sem_trim_region_destroy(trim);
 }
 
-sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_error *err)
+sem_status sem_step_sample(const sem_model *model, int threads, sem_discretization *d,
+                           sem_error *err)
 {
     if (!model || !d) return sem_error_set(err, SEM_ERR_INVALID, "sampling: null argument");
     if (model->n_parts <= 0)
@@ -274,7 +276,7 @@ sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_er
                         : spans * points;
     }
     const int parallel = work > 4000.0 && n_parts > 1;
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(sem_threads(threads)) if (parallel)
     for (int i = 0; i < n_parts; ++i) sample_part(&model->parts[i], i, &parts[i]);
 
     /* first failure in part order, so the message does not depend on scheduling */

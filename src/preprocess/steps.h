@@ -17,7 +17,8 @@
  * knot span in each direction; trimmed parts keep only samples inside their trims, and
  * their spans are subdivided to at least 24 points per direction so a small trimmed region
  * is never missed. */
-sem_status sem_step_sample(const sem_model *model, sem_discretization *d, sem_error *err);
+sem_status sem_step_sample(const sem_model *model, int threads, sem_discretization *d,
+                           sem_error *err);
 /* The samples of each part: (*start)[i] .. (*start)[i + 1] index (*index), a stable counting
  * sort by sample_part, so each part's samples stay in sample order. Both arrays are
  * allocated here (n_parts + 1 and n_samples entries); 0 when out of memory (none left). */
@@ -92,7 +93,7 @@ sem_subray_settings sem_subray_default_settings(void);
 sem_status sem_quadrature_cells(const sem_model *model, const sem_raycast_scene *scene, double h,
                                 const sem_subray_settings *settings, sem_discretization *d,
                                 sem_ray_points **columns, int *n_columns, long long *n_rays,
-                                sem_error *err);
+                                int threads, sem_error *err);
 
 /* quadrature.c: fills quad_spacing, n_quad, quad_X, quad_volume, quad_part, volume (Eq. 11);
  * needs the frame. */

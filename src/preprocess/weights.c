@@ -50,6 +50,7 @@
 #include "steps.h"
 #include "util/free_all.h"
 #include "util/grow.h"
+#include "util/threads.h"
 
 #include <limits.h>
 #include <math.h>
@@ -185,11 +186,7 @@ static sem_status gather_candidates(const sem_raycast_scene *scene, const scene_
 {
     memset(out, 0, sizeof *out);
     const int n_parts = sem_raycast_part_count(scene);
-    int max_threads = 1;
-#ifdef _OPENMP
-    max_threads = n_threads > 0 ? n_threads : omp_get_max_threads();
-#endif
-    (void)n_threads;
+    const int max_threads = sem_threads(n_threads);
     int *point_thread = malloc(((size_t)n_points + 1) * sizeof *point_thread);
     size_t *point_offset = malloc(((size_t)n_points + 1) * sizeof *point_offset);
     int *point_count = malloc(((size_t)n_points + 1) * sizeof *point_count);
@@ -501,16 +498,6 @@ static sem_status build_matrix(const weight_candidates *c, int n_parts, double a
     return SEM_OK;
 }
 
-static int thread_count(int requested)
-{
-#ifdef _OPENMP
-    return requested > 0 ? requested : omp_get_max_threads();
-#else
-    (void)requested;
-    return 1;
-#endif
-}
-
 static sem_status check_points(int n_points, const double *X, const char *what, sem_error *err)
 {
     if (n_points < 0) return sem_error_set(err, SEM_ERR_INVALID, "weights: negative %s count", what);
@@ -559,7 +546,7 @@ sem_status sem_blend_weights(const sem_raycast_scene *scene, int n_points, const
     sem_status st = check_threshold(threshold, err);
     if (st == SEM_OK) st = check_points(n_points, X, "point", err);
     if (st != SEM_OK) return st;
-    return blend_weights(scene, n_points, X, NULL, alpha, threshold, thread_count(0), W, err);
+    return blend_weights(scene, n_points, X, NULL, alpha, threshold, sem_threads(0), W, err);
 }
 
 /* Fraction of non-zero weights at cut-off alpha, or -1 when out of memory. */
@@ -676,7 +663,7 @@ sem_status sem_step_weights(const sem_model *model, const sem_raycast_scene *sce
                                  d->sample_part[k], n_parts);
     d->n_parts = n_parts;
 
-    const int n_threads = thread_count(o->threads);
+    const int n_threads = sem_threads(o->threads);
     scene_scale s = scene_scale_of(scene);
     double alpha = 0.0;
     weight_candidates c;

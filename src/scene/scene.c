@@ -29,12 +29,13 @@ static sem_status fail(ctx *c, const char *where, const char *fmt, ...)
 
 static sem_status fail(ctx *c, const char *where, const char *fmt, ...)
 {
-    char msg[700];
+    char place[1024];
+    snprintf(place, sizeof place, "%s: %s", c->name, where);
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
+    sem_status st = sem_error_vset(c->err, SEM_ERR_INVALID, place, fmt, ap);
     va_end(ap);
-    return sem_error_set(c->err, SEM_ERR_INVALID, "%s: %s: %s", c->name, where, msg);
+    return st;
 }
 
 /* Rejects keys that are not in the NULL-terminated list. */

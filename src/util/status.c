@@ -14,16 +14,28 @@ void sem_text_sanitize(char *text)
         if (*p < 0x20 || *p == 0x7f) *p = '?';
 }
 
-sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...)
+sem_status sem_error_vset(sem_error *err, sem_status status, const char *prefix, const char *fmt,
+                          va_list ap)
 {
     if (err) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err->message, sizeof err->message, fmt, ap);
-        va_end(ap);
+        size_t n = 0;
+        if (prefix && prefix[0]) {
+            int k = snprintf(err->message, sizeof err->message, "%s: ", prefix);
+            n = k < 0 ? 0 : (size_t)k < sizeof err->message ? (size_t)k : sizeof err->message - 1;
+        }
+        vsnprintf(err->message + n, sizeof err->message - n, fmt, ap);
         sem_text_sanitize(err->message);
         err->status = status;
     }
+    return status;
+}
+
+sem_status sem_error_set(sem_error *err, sem_status status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    sem_error_vset(err, status, NULL, fmt, ap);
+    va_end(ap);
     return status;
 }
 
