@@ -127,6 +127,22 @@ static void test_errors(void)
                  "", "objects[0].prescribe.rotate", "not both");
     expect_error(BOX ", \"pin\": {\"parts\": [0]}, \"prescribe\": {\"affine\": [[1, 0, 0, 0]]}", "",
                  "objects[0].prescribe.affine", "3 rows");
+    expect_error(BOX ", \"pin\": {\"parts\": [0]}, \"prescribe\": {\"move\": {\"duration\": 1}}", "",
+                 "objects[0].prescribe.move", "needs \"velocity\"");
+    expect_error(BOX ", \"pin\": {\"parts\": [0]}, \"prescribe\": {\"move\": {\"velocity\": [0, 0, 1]},"
+                     " \"rotate\": {\"degrees_per_second\": 10}}",
+                 "", "objects[0].prescribe", "one of \"affine\", \"rotate\" and \"move\"");
+    {
+        sem_error e;
+        sem_scene *m = parse_object(BOX ", \"pin\": {\"parts\": [0]}, \"prescribe\": {\"move\": {\"velocity\": "
+                                        "[0.5, 0, -0.25], \"duration\": 2}}",
+                                    "", &e);
+        CHECK(m && m->objects[0].prescribe.type == SEM_PRESCRIBE_MOVE &&
+                  m->objects[0].prescribe.velocity[0] == 0.5 && m->objects[0].prescribe.velocity[2] == -0.25 &&
+                  m->objects[0].prescribe.duration == 2,
+              "move: %s", m ? "wrong values" : e.message);
+        sem_scene_destroy(m);
+    }
     expect_error(BOX ", \"region_loads\": [{\"box\": [[0, 0, 0], [1, 1, 1]]}]", "", "objects[0].region_loads[0]",
                  "force_density");
     expect_error(BOX ", \"region_loads\": [{\"box\": [[0, 0, 0], [1, 1, 1]], \"force_density\": [1, 0, 0], "

@@ -89,7 +89,8 @@ int sem_world_def_structured(const sem_world_def *def, size_t n_ctrl, int n_part
 typedef enum sem_prescribe_type {
     SEM_PRESCRIBE_NONE,
     SEM_PRESCRIBE_AFFINE, /* pinned points go to A x0 + b (reached at once) */
-    SEM_PRESCRIBE_ROTATE  /* pinned points rotate about an axis at a rate (rad/s) */
+    SEM_PRESCRIBE_ROTATE, /* pinned points rotate about an axis at a rate (rad/s) */
+    SEM_PRESCRIBE_MOVE    /* pinned points move at a constant velocity (m/s) */
 } sem_prescribe_type;
 
 typedef struct sem_prescribe {
@@ -98,7 +99,8 @@ typedef struct sem_prescribe {
     double axis_point[3];
     double axis_direction[3];
     double rate;            /* rad/s */
-    double duration;        /* rotate only until this time (<= 0: forever) */
+    double duration;        /* rotate or move only until this time (<= 0: forever) */
+    double velocity[3];     /* move: x0 + velocity min(t, duration) */
 } sem_prescribe;
 
 /* A load on the material of a region: force per unit volume (N/m^3) on the volume quadrature

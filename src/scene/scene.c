@@ -395,7 +395,9 @@ static sem_status parse_prescription(ctx *c, const cJSON *pr, const char *w, sem
     sem_status st;
         const cJSON *af = cJSON_GetObjectItemCaseSensitive(pr, "affine");
         const cJSON *ro = cJSON_GetObjectItemCaseSensitive(pr, "rotate");
-        if (af && ro) return fail(c, w, "give either \"affine\" or \"rotate\", not both");
+        const cJSON *mv = cJSON_GetObjectItemCaseSensitive(pr, "move");
+        if ((af != NULL) + (ro != NULL) + (mv != NULL) > 1)
+            return fail(c, w, "give one of \"affine\", \"rotate\" and \"move\"");
         char w2[300];
         if (af) {
             snprintf(w2, sizeof w2, "%s.affine", w);
@@ -427,6 +429,15 @@ static sem_status parse_prescription(ctx *c, const cJSON *pr, const char *w, sem
             if ((st = get_number(c, ro, "duration", w2, &out->duration)) != SEM_OK) return st;
             const double *a = out->axis_direction;
             if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] > 0)) return fail(c, w2, "axis must not be zero");
+        }
+        if (mv) {
+            static const char *const mkeys[] = {"velocity", "duration", NULL};
+            snprintf(w2, sizeof w2, "%s.move", w);
+            if ((st = check_keys(c, mv, w2, mkeys)) != SEM_OK) return st;
+            if (!cJSON_GetObjectItemCaseSensitive(mv, "velocity")) return fail(c, w2, "needs \"velocity\"");
+            out->type = SEM_PRESCRIBE_MOVE;
+            if ((st = get_vec(c, mv, "velocity", w2, 3, out->velocity)) != SEM_OK) return st;
+            if ((st = get_number(c, mv, "duration", w2, &out->duration)) != SEM_OK) return st;
         }
         return SEM_OK;
 }
@@ -669,7 +680,7 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         if (!obj->prescribe_groups) return sem_error_set(c->err, SEM_ERR_NOMEM, "out of memory");
         int k = 0;
         for (const cJSON *it = pr->child; it; it = it->next, ++k) {
-            static const char *const gkeys[] = {"pin", "affine", "rotate", NULL};
+            static const char *const gkeys[] = {"pin", "affine", "rotate", "move", NULL};
             char w2[300], w3[320];
             snprintf(w2, sizeof w2, "%s[%d]", w, k);
             if ((st = check_keys(c, it, w2, gkeys)) != SEM_OK) return st;
@@ -682,10 +693,10 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
                                       &gr->parts, &gr->n_parts, &gr->points, &gr->n_points)) != SEM_OK)
                 return st;
             if ((st = parse_prescription(c, it, w2, &gr->prescribe)) != SEM_OK) return st;
-            if (gr->prescribe.type == SEM_PRESCRIBE_NONE) return fail(c, w2, "needs \"affine\" or \"rotate\"");
+            if (gr->prescribe.type == SEM_PRESCRIBE_NONE) return fail(c, w2, "needs \"affine\", \"rotate\" or \"move\"");
         }
     } else if (pr) {
-        static const char *const pkeys[] = {"affine", "rotate", NULL};
+        static const char *const pkeys[] = {"affine", "rotate", "move", NULL};
         snprintf(w, sizeof w, "%s.prescribe", where);
         if ((st = check_keys(c, pr, w, pkeys)) != SEM_OK) return st;
         if ((st = parse_prescription(c, pr, w, &obj->prescribe)) != SEM_OK) return st;
