@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/net_size.h"
 #include "geometry/seam.h"
 #include "sem/nurbs.h"
 
@@ -88,33 +89,9 @@ static double dist3(const double *a, const double *b)
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/* The bounding box of the surface's control points (it holds the surface: weights are
- * positive). */
-static void control_box(const sem_surface *s, double lo[3], double hi[3])
-{
-    for (int d = 0; d < 3; ++d) {
-        lo[d] = INFINITY;
-        hi[d] = -INFINITY;
-    }
-    size_t n = (size_t)s->n_u * (size_t)s->n_v;
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d) {
-            lo[d] = fmin(lo[d], s->ctrl[3 * i + d]);
-            hi[d] = fmax(hi[d], s->ctrl[3 * i + d]);
-        }
-}
-
-static double surface_size(const sem_surface *s)
-{
-    double lo[3], hi[3];
-    control_box(s, lo, hi);
-    double size = dist3(lo, hi);
-    return size > 0 && isfinite(size) ? size : 1.0;
-}
-
 sem_trim_projection_settings sem_default_trim_projection_settings(const sem_surface *s)
 {
-    double size = surface_size(s);
+    double size = sem_surface_net_size(s);
     sem_trim_projection_settings o = {2e-5 * size, 1e-2 * size, 1e-4 * size};
     return o;
 }
@@ -468,7 +445,7 @@ static sem_status project_pass(const sem_surface_sampler *sampler, const sem_cur
      * farther from that box than allowed fails the loop before any point is projected (a
      * stray curve would otherwise cost every one of its points a full inversion search) */
     double lo[3], hi[3], apart = 0;
-    control_box(c.s, lo, hi);
+    sem_surface_net_box(c.s, lo, hi);
     double last[3];
     for (int k = 0; k < n_curves; ++k) {
         const sem_curve *cv = &curves[k];

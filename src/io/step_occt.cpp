@@ -90,6 +90,7 @@
 #include <gp_Pnt2d.hxx>
 
 extern "C" {
+#include "geometry/net_size.h"
 #include "geometry/trim_fix.h"
 #include "io/atomic_file.h"
 #include "io/read_file.h"
@@ -556,20 +557,6 @@ Handle(Geom2d_BSplineCurve) curve_to_occt(const sem_curve *c)
     return b;
 }
 
-double surface_size(const sem_surface *s)
-{
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    size_t n = (size_t)s->n_u * (size_t)s->n_v;
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d) {
-            lo[d] = std::min(lo[d], s->ctrl[3 * i + d]);
-            hi[d] = std::max(hi[d], s->ctrl[3 * i + d]);
-        }
-    double size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                            (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    return size > 0 && std::isfinite(size) ? size : 1.0;
-}
-
 /* A wire on the surface from a trim loop, its gaps closed by ShapeFix_Wire. */
 TopoDS_Wire wire_to_occt(const sem_trim_loop *loop, const Handle(Geom_BSplineSurface) & surface,
                          const TopoDS_Face &face, double precision)
@@ -615,7 +602,7 @@ TopoDS_Face face_from_part(const sem_part *part)
 {
     const sem_surface *s = &part->surface;
     Handle(Geom_BSplineSurface) surface = surface_to_occt(s);
-    double precision = 1e-7 * surface_size(s);
+    double precision = 1e-7 * sem_surface_net_size(s);
     /* the untrimmed face over the part's domain; trimmed parts replace its outer wire */
     TopoDS_Face whole = BRepBuilderAPI_MakeFace(surface, s->u0, s->u1, s->v0, s->v1, precision).Face();
     if (!part->has_outer && part->n_holes == 0) return whole;
