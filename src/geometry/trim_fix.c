@@ -423,3 +423,13 @@ sem_status sem_part_fix_loops(sem_part *part, sem_loop_fix *fix)
     }
     return st;
 }
+
+void sem_part_untrim(sem_part *part)
+{
+    sem_part keep;
+    memset(&keep, 0, sizeof keep);
+    keep.surface = part->surface;
+    memset(&part->surface, 0, sizeof part->surface);
+    sem_part_free(part);
+    *part = keep;
+}

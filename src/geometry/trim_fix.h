@@ -29,6 +29,10 @@ typedef struct sem_loop_fix {
  * Fails only when out of memory. */
 sem_status sem_part_fix_loops(sem_part *part, sem_loop_fix *fix);
 
+/* What a reader does with a face whose loops cannot be made usable: the part keeps only its
+ * surface (untrimmed); its loops and everything else are freed and zeroed. */
+void sem_part_untrim(sem_part *part);
+
 /* Exact reversal of a curve: control points and weights in reverse order, knots t -> a + b - t. */
 void sem_curve_reverse(sem_curve *c);
 

@@ -12,6 +12,7 @@
  */
 #include <string.h>
 
+#include "geometry/trim_fix.h"
 #include "io/iges_internal.h"
 
 /* Model-space curve of edge `index` (1-based) of a 504 edge list, in the coordinates m. */
@@ -160,12 +161,7 @@ sem_status iges_emit_face(iges_reader *r, int idx, const double *parent, int dep
         sem_model_warn(r->model, "entity 510 (DE %d): a loop of the face could not be built; "
                                  "the face is kept untrimmed",
                        iges_de_number(idx));
-        sem_part keep;
-        memset(&keep, 0, sizeof keep);
-        keep.surface = part.surface;
-        memset(&part.surface, 0, sizeof part.surface);
-        sem_part_free(&part);
-        part = keep;
+        sem_part_untrim(&part);
     }
     return iges_finish_part(r, &part, idx, surf);
 }

@@ -705,12 +705,7 @@ sem_status read_step(const char *path, sem_model **out, sem_error *err)
             sem_error verr;
             if (sem_part_validate_trims(&part, &verr) != SEM_OK) {
                 sem_model_warn(m, "face %d: %s; kept untrimmed", index + 1, verr.message);
-                sem_part keep;
-                memset(&keep, 0, sizeof keep);
-                keep.surface = part.surface;
-                memset(&part.surface, 0, sizeof part.surface);
-                sem_part_free(&part);
-                part = keep;
+                sem_part_untrim(&part);
             }
             built += part_control_points(&part);
             if (built > SEM_MAX_MODEL_CONTROL_POINTS) {
