@@ -273,6 +273,24 @@ static int merge_hits(const sem_raycast_scene *s, const double *dir, sem_ray_hit
 
 /* All hits in (t_near, t_far), merged and sorted. Returns the count (writes at most
  * max_hits), or -1 when out of memory. */
+/* An Embree ray from origin along dir over (t_near, t_far) (t_near clamped at 0, t_far
+ * beyond float range: unbounded), no hit yet. The flags field is zero (memset). */
+static void ray_init(struct RTCRayHit *rh, const double origin[3], const double dir[3], double t_near, double t_far)
+{
+    memset(rh, 0, sizeof *rh);
+    rh->ray.org_x = (float)origin[0];
+    rh->ray.org_y = (float)origin[1];
+    rh->ray.org_z = (float)origin[2];
+    rh->ray.dir_x = (float)dir[0];
+    rh->ray.dir_y = (float)dir[1];
+    rh->ray.dir_z = (float)dir[2];
+    rh->ray.tnear = t_near > 0 ? (float)t_near : 0.0f;
+    rh->ray.tfar = t_far < 3e38 ? (float)t_far : INFINITY;
+    rh->ray.mask = 0xFFFFFFFFu;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 int sem_raycast_all_hits(const sem_raycast_scene *s, const double *origin, const double *dir,
                     double t_near, double t_far, sem_ray_hit *out, int max_hits, int use_sign)
 {
@@ -289,19 +307,7 @@ int sem_raycast_all_hits(const sem_raycast_scene *s, const double *origin, const
     c.failed = 0;
 
     struct RTCRayHit rh;
-    memset(&rh, 0, sizeof rh);
-    rh.ray.org_x = (float)origin[0];
-    rh.ray.org_y = (float)origin[1];
-    rh.ray.org_z = (float)origin[2];
-    rh.ray.dir_x = (float)dir[0];
-    rh.ray.dir_y = (float)dir[1];
-    rh.ray.dir_z = (float)dir[2];
-    rh.ray.tnear = t_near > 0 ? (float)t_near : 0.0f;
-    rh.ray.tfar = t_far < 3e38 ? (float)t_far : INFINITY;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    ray_init(&rh, origin, dir, t_near, t_far);
     if (rh.ray.tfar > rh.ray.tnear) rtcIntersect1(s->scene, &c.context, &rh);
 
     int n = -1;
@@ -334,18 +340,7 @@ int sem_raycast_first(const sem_raycast_scene *scene, const double origin[3], co
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     struct RTCRayHit rh;
-    memset(&rh, 0, sizeof rh);
-    rh.ray.org_x = (float)origin[0];
-    rh.ray.org_y = (float)origin[1];
-    rh.ray.org_z = (float)origin[2];
-    rh.ray.dir_x = (float)dir[0];
-    rh.ray.dir_y = (float)dir[1];
-    rh.ray.dir_z = (float)dir[2];
-    rh.ray.tnear = t_near > 0 ? (float)t_near : 0.0f;
-    rh.ray.tfar = t_far < 3e38 ? (float)t_far : INFINITY;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    ray_init(&rh, origin, dir, t_near, t_far);
     if (!(rh.ray.tfar > rh.ray.tnear)) return 0;
     rtcIntersect1(scene->scene, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.geomID >= (unsigned)scene->n_parts)
