@@ -10,13 +10,17 @@
 #   --jobs N                                 N fuzzing processes on one corpus (libFuzzer's fork
 #                                            mode; --runs counts all of them; a crash, timeout or
 #                                            out-of-memory still stops the run)
+#   --keep                                   after a run that found nothing, pack the corpus into
+#                                            fuzz/long/NAME.tar.xz (committed: the long runs'
+#                                            corpus, which a run with --runs starts from)
 #
 # Harnesses: iges, obj, scene, cache (fuzz/fuzz_NAME.c). Seeds: fuzz/corpus/NAME plus, when
 # present, the shared models of the right kind (SEM_SHARED_MODELS, default ../shared/models)
-# no larger than --max-len. What libFuzzer finds is kept in build-fuzz/corpus/NAME; a crash,
-# leak, timeout (> 10 s) or memory use above 1 GB is saved in build-fuzz/crashes/NAME/ and
-# makes the script fail: copy the input into fuzz/regressions/NAME/ once it is fixed, where the
-# test suite replays it for ever. The last lines of every run are in build-fuzz/logs/NAME.log.
+# no larger than --max-len, and for a run with --runs the long runs' corpus
+# fuzz/long/NAME.tar.xz. What libFuzzer finds is kept in build-fuzz/corpus/NAME; a crash, leak,
+# timeout (> 10 s) or memory use above 1 GB is saved in build-fuzz/crashes/NAME/ and makes the
+# script fail: copy the input into fuzz/regressions/NAME/ once it is fixed, where the test
+# suite replays it for ever. The last lines of every run are in build-fuzz/logs/NAME.log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,6 +30,7 @@ soak=0
 max_len=65536
 timeout=10
 jobs=1
+keep=0
 names=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -35,7 +40,8 @@ while [ $# -gt 0 ]; do
     --timeout) timeout="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --soak) soak=1; shift ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --keep) keep=1; shift ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     iges|obj|scene|cache) names+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -61,6 +67,9 @@ for n in "${names[@]}"; do
   seeds="$build/seeds/$n"
   crashes="$build/crashes/$n"
   mkdir -p "$corpus" "$seeds" "$crashes" "$build/logs"
+  if [ "$runs" != 0 ] && [ -f "fuzz/long/$n.tar.xz" ]; then
+    tar xJf "fuzz/long/$n.tar.xz" -C "$build/corpus"
+  fi
   case "$n" in
     iges) pattern='.*\.(igs|iges)$' ;;
     obj) pattern='.*\.obj$' ;;
@@ -88,6 +97,11 @@ for n in "${names[@]}"; do
     echo "fuzz: $n FAILED (exit $rc); input saved in $crashes/, log in $log:" >&2
     grep -E 'ERROR|SUMMARY|fuzz:' "$log" | head -5 >&2 || true
     failed=1
+  elif [ "$keep" = 1 ]; then
+    mkdir -p fuzz/long
+    tar cf - -C "$build/corpus" "$n" | xz -9 > "fuzz/long/$n.tar.xz.tmp"
+    mv "fuzz/long/$n.tar.xz.tmp" "fuzz/long/$n.tar.xz"
+    echo "fuzz: $n: corpus kept in fuzz/long/$n.tar.xz ($(ls "$corpus" | wc -l) units)" >&2
   fi
 done
 
