@@ -3,6 +3,7 @@
  */
 #include "collision_mesh.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -81,6 +82,124 @@ static int compare_link(const void *x, const void *y)
  * the heuristic it always was, exact for star-shaped bodies). The preprocessing's own
  * orientation fix is not part of the discretization. Leaves edge_other for the turned
  * triangles. */
+/* Each point's copies (copy_start, copy_point): the points of its weld group on its own part.
+ * The weld groups are gathered first (a counting sort by representative), then each point
+ * lists the members of its group with its part. */
+static sem_status find_copies(sem_collision_mesh *m, const int *point_part, sem_error *err)
+{
+    const int n = m->n_points;
+    int *group_start = calloc((size_t)n + 2, sizeof(int)), *group_member = malloc(((size_t)n + 1) * sizeof(int));
+    int *fill = malloc(((size_t)n + 1) * sizeof(int));
+    m->copy_start = calloc((size_t)n + 2, sizeof(int));
+    if (!group_start || !group_member || !fill || !m->copy_start) {
+        SEM_FREE_ALL(group_start, group_member, fill);
+        return sem_error_set(err, SEM_ERR_NOMEM, "contact: out of memory");
+    }
+    for (int p = 0; p < n; ++p) group_start[m->weld[p] + 1]++;
+    for (int p = 0; p < n; ++p) group_start[p + 1] += group_start[p];
+    memcpy(fill, group_start, (size_t)n * sizeof(int));
+    for (int p = 0; p < n; ++p) group_member[fill[m->weld[p]]++] = p;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int p = 0; p < n; ++p) {
+            int g = m->weld[p], count = 0;
+            for (int k = group_start[g]; k < group_start[g + 1]; ++k) {
+                int q = group_member[k];
+                if (point_part[q] != point_part[p]) continue;
+                if (pass == 1) m->copy_point[m->copy_start[p] + count] = q;
+                ++count;
+            }
+            if (pass == 0) m->copy_start[p + 1] = m->copy_start[p] + count;
+        }
+        if (pass == 0 && !(m->copy_point = malloc(((size_t)m->copy_start[n] + 1) * sizeof(int)))) {
+            SEM_FREE_ALL(group_start, group_member, fill);
+            return sem_error_set(err, SEM_ERR_NOMEM, "contact: out of memory");
+        }
+    }
+    SEM_FREE_ALL(group_start, group_member, fill);
+    return SEM_OK;
+}
+
+/* One row for every copy: the mean of the copies' rows (entries by control point, in order of
+ * control point). At rest the copies are one point; with their own rows they move apart as the
+ * control points of a collapsed edge do (a sphere's pole, whose control points are free), so
+ * the fan of triangles at the pole opens into slivers whose orientation is noise and the copy
+ * a query finds changes from one Newton iterate to the next (a ball pressed pole-first onto a
+ * box did not converge: relative gradient 0.85). With one row they stay one point: the
+ * collision surface at the pole follows the mean of the collapsed control points. Points
+ * without copies keep their rows as they are. */
+static sem_status merge_copy_rows(sem_collision_mesh *m, sem_error *err)
+{
+    const int n = m->n_points;
+    int merged = 0, widest = 0;
+    for (int p = 0; p < n; ++p) {
+        int count = m->copy_start[p + 1] - m->copy_start[p], entries = 0;
+        if (count < 2) continue;
+        merged = 1;
+        for (int k = m->copy_start[p]; k < m->copy_start[p + 1]; ++k)
+            entries += m->row_start[m->copy_point[k] + 1] - m->row_start[m->copy_point[k]];
+        if (entries > widest) widest = entries;
+    }
+    if (!merged) return SEM_OK;
+    int *start = malloc(((size_t)n + 1) * sizeof(int)), *ctrl = NULL, *tmp_ctrl = malloc(((size_t)widest + 1) * sizeof(int));
+    double *w = NULL, *tmp_w = malloc(((size_t)widest + 1) * sizeof(double));
+    size_t total = 0;
+    int ok = start && tmp_ctrl && tmp_w;
+    for (int pass = 0; ok && pass < 2; ++pass) {
+        total = 0;
+        for (int p = 0; p < n; ++p) {
+            int count = m->copy_start[p + 1] - m->copy_start[p], len = 0;
+            if (count < 2) {
+                len = m->row_start[p + 1] - m->row_start[p];
+                if (pass == 1) {
+                    memcpy(ctrl + total, m->row_ctrl + m->row_start[p], (size_t)len * sizeof(int));
+                    memcpy(w + total, m->row_w + m->row_start[p], (size_t)len * sizeof(double));
+                }
+            } else {
+                /* the union of the copies' control points, sorted (insertion: a few dozen) */
+                for (int k = m->copy_start[p]; k < m->copy_start[p + 1]; ++k) {
+                    int q = m->copy_point[k];
+                    for (int e = m->row_start[q]; e < m->row_start[q + 1]; ++e) {
+                        int c = m->row_ctrl[e], at = len;
+                        while (at > 0 && tmp_ctrl[at - 1] > c) --at;
+                        if (at > 0 && tmp_ctrl[at - 1] == c) {
+                            tmp_w[at - 1] += m->row_w[e];
+                            continue;
+                        }
+                        memmove(tmp_ctrl + at + 1, tmp_ctrl + at, (size_t)(len - at) * sizeof(int));
+                        memmove(tmp_w + at + 1, tmp_w + at, (size_t)(len - at) * sizeof(double));
+                        tmp_ctrl[at] = c;
+                        tmp_w[at] = m->row_w[e];
+                        ++len;
+                    }
+                }
+                if (pass == 1)
+                    for (int e = 0; e < len; ++e) {
+                        ctrl[total + (size_t)e] = tmp_ctrl[e];
+                        w[total + (size_t)e] = tmp_w[e] / count;
+                    }
+            }
+            if (pass == 0) start[p] = (int)total;
+            total += (size_t)len;
+        }
+        if (pass == 0) {
+            start[n] = (int)total;
+            ctrl = malloc((total + 1) * sizeof(int));
+            w = malloc((total + 1) * sizeof(double));
+            ok = ctrl && w && total <= INT_MAX;
+        }
+    }
+    SEM_FREE_ALL(tmp_ctrl, tmp_w);
+    if (!ok) {
+        SEM_FREE_ALL(start, ctrl, w);
+        return sem_error_set(err, SEM_ERR_NOMEM, "contact: out of memory");
+    }
+    SEM_FREE_ALL(m->row_start, m->row_ctrl, m->row_w);
+    m->row_start = start;
+    m->row_ctrl = ctrl;
+    m->row_w = w;
+    return SEM_OK;
+}
+
 static sem_status orient_parts(sem_collision_mesh *m, const sem_mesh *mesh, sem_error *err)
 {
     int np = mesh->n_parts, nt = m->n_triangles;
@@ -224,7 +343,7 @@ static void update_normals(sem_collision_mesh *m)
 void sem_collision_mesh_free(sem_collision_mesh *m)
 {
     SEM_FREE_ALL(m->row_start, m->row_ctrl, m->row_w, m->area, m->triangles, m->x, m->x0, m->pseudo_normal,
-                 m->face_normal, m->weld, m->edge_other);
+                 m->face_normal, m->weld, m->edge_other, m->copy_start, m->copy_point);
     sem_bvh_free(&m->bvh);
     memset(m, 0, sizeof *m);
 }
@@ -258,6 +377,7 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     memset(&mesh, 0, sizeof mesh);
     int *index = NULL, *used = NULL;
     double *phi = NULL;
+    int *point_part = NULL;
     if (resolution <= 0 && (st = automatic_resolution(model, out->length, err, &resolution)) != SEM_OK)
         goto done;
     out->resolution = resolution;
@@ -286,12 +406,13 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     out->x = calloc(3 * np, sizeof(double));
     out->pseudo_normal = calloc(3 * np, sizeof(double));
     out->weld = malloc(np * sizeof(int));
+    point_part = malloc(np * sizeof(int));
     out->face_normal = calloc(3 * (size_t)mesh.n_triangles + 1, sizeof(double));
     out->edge_other = malloc((3 * (size_t)mesh.n_triangles + 1) * sizeof(int));
     out->n_triangles = mesh.n_triangles;
     out->triangles = malloc((3 * (size_t)mesh.n_triangles + 1) * sizeof(int));
     if (!out->row_start || !out->row_ctrl || !out->row_w || !out->area || !out->x || !out->pseudo_normal ||
-        !out->triangles || !out->weld || !out->face_normal || !out->edge_other)
+        !out->triangles || !out->weld || !out->face_normal || !out->edge_other || !point_part)
         goto nomem;
     out->row_start[0] = 0;
     int part = 0;
@@ -301,6 +422,7 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
         const sem_surface *s = &model->parts[part].surface;
         int n = sem_surface_basis(s, mesh.uv[2 * v], mesh.uv[2 * v + 1], index, phi, NULL, NULL);
         int r = used[v], start = out->row_start[r], kept = 0;
+        point_part[r] = part;
         for (int k = 0; k < n; ++k) {
             if (phi[k] == 0) continue;
             out->row_ctrl[start + kept] = (int)part_offset[part] + index[k];
@@ -312,8 +434,10 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     for (int t = 0; t < 3 * mesh.n_triangles; ++t) out->triangles[t] = used[mesh.triangles[t]];
     update_positions(out, q);
     if ((st = sem_weld_points(out->x, out->n_points, WELD_TOLERANCE * out->length, out->weld, err)) != SEM_OK ||
-        (st = orient_parts(out, &mesh, err)) != SEM_OK)
+        (st = orient_parts(out, &mesh, err)) != SEM_OK || (st = find_copies(out, point_part, err)) != SEM_OK ||
+        (st = merge_copy_rows(out, err)) != SEM_OK)
         goto done;
+    update_positions(out, q); /* the copies at their one row */
     update_normals(out); /* of the turned triangles */
     for (int t = 0; t < out->n_triangles; ++t) {
         const int *tri = out->triangles + 3 * t;
@@ -334,7 +458,7 @@ done:
     if (st != SEM_OK) sem_collision_mesh_free(out);
     sem_mesh_free(&mesh);
     sem_mesh_template_destroy(tmpl);
-    SEM_FREE_ALL(index, phi, used, q, part_offset);
+    SEM_FREE_ALL(index, phi, used, q, part_offset, point_part);
     return st;
 }
 

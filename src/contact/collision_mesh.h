@@ -14,6 +14,9 @@
  * (within 1e-4 of the object's size) are welded, the triangles across each edge found, and
  * the parts turned to one orientation across their seams, so that the face, edge and
  * angle-weighted vertex pseudonormals see one closed surface where the model is closed.
+ * Welded points of one part (the corners of a collapsed edge: a sphere's pole has a vertex per
+ * u) share one row, the mean of theirs, so that they stay one point as the collapsed control
+ * points move apart; the triangles that keep no area there take part in no query.
  */
 #ifndef SEM_CONTACT_COLLISION_MESH_H
 #define SEM_CONTACT_COLLISION_MESH_H
@@ -34,6 +37,9 @@ typedef struct sem_collision_mesh {
     double *face_normal;   /* current unit triangle normals (outward) */
     double *pseudo_normal; /* current angle-weighted vertex normals over the welded point */
     int *weld;             /* the point's representative: points that coincide at rest */
+    int *copy_start;       /* n_points + 1: the point's copies in copy_point (itself included): */
+    int *copy_point;       /* the points of its part that coincide with it at rest (the corners
+                            * of a collapsed edge: a sphere's pole has one per u) */
     int *edge_other;       /* 3 per triangle: the triangle across edge e (vertex e to e + 1), or -1 */
     double length;         /* bounding-box diagonal at rest */
     int resolution;        /* tessellation cells per knot span used */

@@ -314,6 +314,18 @@ void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out) { *out 
 /* Self-contact on (sem_contact_def.self: 0 the default, on; -1 off). */
 static int self_on(const sem_contact *c) { return !c->def.disabled && c->def.self >= 0; }
 
+/* Is triangle t of the mesh collapsed (two corners one welded point: at a sphere's pole, a
+ * cone's tip)? Its copies share one row (collision_mesh.c), so it stays a segment with no
+ * normal to sign a distance by; its neighbours, which share that segment, stand in. */
+static int collapsed(const sem_collision_mesh *m, int t)
+{
+    const int *v = m->triangles + 3 * (size_t)t;
+    int a = m->weld[v[0]], b = m->weld[v[1]], c = m->weld[v[2]];
+    return a == b || b == c || a == c;
+}
+
+static int collapsed_excluded(int t, void *context) { return collapsed(context, t); }
+
 /* Self-contact's exclusion rule (SELF_EXCLUSION): is triangle t of the mesh within the
  * excluded rest distance of the point? */
 typedef struct self_exclusion {
@@ -325,6 +337,7 @@ typedef struct self_exclusion {
 static int self_excluded(int t, void *context)
 {
     const self_exclusion *e = context;
+    if (collapsed(e->mesh, t)) return 1;
     const int *v = e->mesh->triangles + 3 * (size_t)t;
     const double *x0 = e->mesh->x0;
     sem_tri_closest cl;
@@ -505,7 +518,8 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         const contact_object *cj = &c->objects[c->sys_to_contact[j]];
         const sem_collision_mesh *mj = &cj->mesh;
         sem_tri_closest cl;
-        int t = sem_bvh_closest(&mj->bvh, mj->x, mj->triangles, x, reach2, &cl);
+        int t = sem_bvh_closest_except(&mj->bvh, mj->x, mj->triangles, x, reach2, collapsed_excluded,
+                                       (void *)mj, &cl);
         if (t < 0) continue;
         contact_rec r = {k, p, j, -1, t, {cl.bary[0], cl.bary[1], cl.bary[2]}, 0, {0, 0, 0}, 0, th, 0};
         double outward[3];
