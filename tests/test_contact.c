@@ -340,6 +340,25 @@ static void test_two_spheres(sem_integrator integ, const char *name)
     test_setup_free(&far);
 }
 
+/* A solid of `model` (E, rho 1000, nu 0.45) preprocessed at sem's defaults, added to w. */
+static int add_solid(test_setup *s, sem_world *w, double youngs)
+{
+    sem_error err;
+    sem_preprocess_options po = sem_default_preprocess_options();
+    po.q_space_operators = 1;
+    po.youngs_modulus = youngs;
+    sem_status st = sem_preprocess(s->model, &po, &s->disc, &err);
+    CHECK(st == SEM_OK, "preprocess: %s", err.message);
+    if (st != SEM_OK) return 0;
+    sem_object_def od = sem_default_object_def();
+    od.material.youngs_modulus = youngs;
+    od.model = s->model;
+    od.disc = s->disc;
+    int id = sem_world_add_object(w, &od, &err);
+    CHECK(id >= 0, "add object: %s", err.message);
+    return id >= 0;
+}
+
 /* A rubber box (rho 1000, E 1e5, nu 0.45) of edge `size` at `center`, preprocessed at sem's
  * defaults, added to world w. */
 static int add_box(test_setup *s, sem_world *w, double size, const double center[3])
@@ -351,17 +370,23 @@ static int add_box(test_setup *s, sem_world *w, double size, const double center
     bd.size[0] = bd.size[1] = bd.size[2] = size;
     memcpy(bd.center, center, sizeof bd.center);
     sem_status st = s->model ? sem_primitive_box(s->model, &bd, &err) : SEM_ERR_NOMEM;
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.q_space_operators = 1;
-    po.youngs_modulus = 1e5; /* gamma = 1000 E / L, as a scene sets it from the material */
-    if (st == SEM_OK) st = sem_preprocess(s->model, &po, &s->disc, &err);
     CHECK(st == SEM_OK, "box: %s", err.message);
-    if (st != SEM_OK) return 0;
-    sem_object_def od = sem_default_object_def();
-    od.material.youngs_modulus = 1e5;
-    od.model = s->model;
-    od.disc = s->disc;
-    return sem_world_add_object(w, &od, &err) >= 0;
+    return st == SEM_OK && add_solid(s, w, 1e5);
+}
+
+/* The world of the drops between objects: gravity, implicit Euler at dt 0.01, every other
+ * setting at its default (the q-space solvers, which take contact terms). */
+static sem_world *drop_world(void)
+{
+    sem_error err;
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = -G;
+    wd.integrator = SEM_IMPLICIT_EULER;
+    wd.dt = 0.01;
+    wd.advanced.q_space_solvers = 1;
+    sem_world *w = sem_world_create(&wd, &err);
+    CHECK(w != NULL, "world: %s", err.message);
+    return w;
 }
 
 /* Two equal rubber boxes (0.4 m, E 1e5) stacked face to face, edges over edges, the upper one
@@ -379,13 +404,7 @@ static void test_stack(void)
     memset(&up, 0, sizeof up);
     const double cl[3] = {0, 0, 0.201}, cu[3] = {0, 0, 0.61};
     sem_error err;
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = -G;
-    wd.integrator = SEM_IMPLICIT_EULER;
-    wd.dt = 0.01;
-    wd.advanced.q_space_solvers = 1;
-    sem_world *w = sem_world_create(&wd, &err);
-    CHECK(w != NULL, "world: %s", err.message);
+    sem_world *w = drop_world();
     if (!w || !add_box(&lo, w, 0.4, cl) || !add_box(&up, w, 0.4, cu)) {
         sem_world_destroy(w);
         test_setup_free(&lo);
@@ -419,25 +438,6 @@ static void test_stack(void)
     test_setup_free(&up);
 }
 
-/* A solid of `model` (E, rho 1000, nu 0.45) preprocessed at sem's defaults, added to w. */
-static int add_solid(test_setup *s, sem_world *w, double youngs)
-{
-    sem_error err;
-    sem_preprocess_options po = sem_default_preprocess_options();
-    po.q_space_operators = 1;
-    po.youngs_modulus = youngs;
-    sem_status st = sem_preprocess(s->model, &po, &s->disc, &err);
-    CHECK(st == SEM_OK, "preprocess: %s", err.message);
-    if (st != SEM_OK) return 0;
-    sem_object_def od = sem_default_object_def();
-    od.material.youngs_modulus = youngs;
-    od.model = s->model;
-    od.disc = s->disc;
-    int id = sem_world_add_object(w, &od, &err);
-    CHECK(id >= 0, "add object: %s", err.message);
-    return id >= 0;
-}
-
 /* A rubber ball (r 0.25 m, E 1e5) dropped pole first onto a stiff plate (1.2 x 1.2 x 0.1 m,
  * E 1e8) lying on the ground. The pole is a collapsed edge of the sphere's NURBS: one point at
  * rest, with a tessellation vertex per u, each a different row over the collapsed control
@@ -451,12 +451,7 @@ static void test_pole_first(void)
     memset(&ball, 0, sizeof ball);
     memset(&plate, 0, sizeof plate);
     sem_error err;
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = -G;
-    wd.integrator = SEM_IMPLICIT_EULER;
-    wd.dt = 0.01;
-    wd.advanced.q_space_solvers = 1;
-    sem_world *w = sem_world_create(&wd, &err);
+    sem_world *w = drop_world();
     ball.model = sem_model_create();
     plate.model = sem_model_create();
     sem_sphere_def sd = sem_default_sphere_def();
@@ -465,7 +460,6 @@ static void test_pole_first(void)
     bd.size[0] = bd.size[1] = 1.2;
     bd.size[2] = 0.1;
     bd.center[2] = 0.05;
-    CHECK(w != NULL, "world: %s", err.message);
     int ok = w && ball.model && plate.model && sem_primitive_sphere(ball.model, &sd, &err) == SEM_OK &&
              sem_primitive_box(plate.model, &bd, &err) == SEM_OK;
     CHECK(ok, "set-up: %s", err.message);

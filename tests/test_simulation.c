@@ -408,15 +408,41 @@ static void test_assembly_chunks(void)
     free(qb);
 }
 
-/* Driven rotation with the paper's linearly implicit step: the x = 0 end cap of a
- * 3-section beam turns about the beam's axis at a constant rate (zero gravity) and the
- * whole beam starts with that angular velocity. A rigid rotation is a zero mode of K, so
- * the free rows of (M + h^2 K) v+ = M v are solved by the rigid velocity only if the
- * pinned points' velocities enter the right-hand side through the right stiffness block
- * A_fp (kept for one triangle of group pairs, the other being its transpose). After 0.4 s
- * (0.2 rad) every free control point of the 1 m wide beam is within 1.5e-4 m of the rigidly rotated
- * rest position (3.4e-5 measured; the tangential steps drift off the circle). Without
- * the transposed blocks the worst point is 9e-4 off, without A_fp's stiffness 3.9e-3. */
+/* The driven-beam set-up: a 3-section make_model beam whose x = 0 end cap follows pr, in a
+ * world without gravity (dt 0.01), E 1e7, rho 1000, starting at angular velocity spin about x.
+ * *q0 gets the rest control points and *group the cap (0) and the rest (-1), both freed by the
+ * caller. Returns 1 when the object is in the world. */
+static int driven_beam(test_setup *s, const sem_prescribe *pr, double spin, double **q0, int **group,
+                       size_t *nc)
+{
+    sem_error err;
+    *q0 = NULL;
+    *group = NULL;
+    if (!make_model(s, 3, 2, 6)) return 0;
+    *nc = sem_model_control_points(s->model);
+    *q0 = malloc(3 * *nc * sizeof(double));
+    *group = malloc(*nc * sizeof(int));
+    if (!*q0 || !*group) return 0;
+    sem_model_get_q(s->model, *q0);
+    for (size_t c = 0; c < *nc; ++c) (*group)[c] = fabs((*q0)[3 * c]) < 1e-9 ? 0 : -1;
+    sem_world_def wd = sem_default_world_def();
+    wd.gravity[2] = 0;
+    wd.dt = 0.01;
+    s->world = sem_world_create(&wd, &err);
+    sem_object_def od = sem_default_object_def();
+    od.model = s->model;
+    od.disc = s->disc;
+    od.prescribe_group = *group;
+    od.prescribes = pr;
+    od.n_prescribes = 1;
+    od.material.youngs_modulus = 1e7;
+    od.material.density = 1000;
+    od.initial_angular_velocity[0] = spin;
+    int ok = s->world && sem_world_add_object(s->world, &od, &err) == 0;
+    CHECK(ok, "%s", err.message);
+    return ok;
+}
+
 /* A pinned end moved at a constant velocity (SEM_PRESCRIBE_MOVE): the pinned control points
  * are at x0 + v min(t, duration) after every step, exactly, and the beam they pull follows
  * (its centre of mass moves by most of v t). */
@@ -427,33 +453,13 @@ static void test_driven_move(void)
     size_t nc = 0;
     double *q0 = NULL;
     int *group = NULL;
-    if (!make_model(&s, 3, 2, 6)) goto done;
-    nc = sem_model_control_points(s.model);
-    q0 = malloc(3 * nc * sizeof(double));
-    group = malloc(nc * sizeof(int));
-    if (!q0 || !group) goto done;
-    sem_model_get_q(s.model, q0);
-    for (size_t c = 0; c < nc; ++c) group[c] = fabs(q0[3 * c]) < 1e-9 ? 0 : -1;
     sem_prescribe pr;
     memset(&pr, 0, sizeof pr);
     pr.type = SEM_PRESCRIBE_MOVE;
     pr.velocity[0] = 0.3;
     pr.velocity[2] = -0.4;
     pr.duration = 0.2;
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = 0;
-    wd.dt = 0.01;
-    s.world = sem_world_create(&wd, &err);
-    sem_object_def od = sem_default_object_def();
-    od.model = s.model;
-    od.disc = s.disc;
-    od.prescribe_group = group;
-    od.prescribes = &pr;
-    od.n_prescribes = 1;
-    od.material.youngs_modulus = 1e7;
-    od.material.density = 1000;
-    int ok = s.world && sem_world_add_object(s.world, &od, &err) == 0;
-    CHECK(ok, "%s", err.message);
+    int ok = driven_beam(&s, &pr, 0, &q0, &group, &nc);
     sem_object_stats st0, st;
     if (ok) sem_world_object_stats(s.world, 0, &st0);
     double worst = 0;
@@ -473,12 +479,20 @@ static void test_driven_move(void)
            worst, moved, pr.velocity[0] * pr.duration);
     CHECK(ok && worst <= 1e-12, "pinned points are %g m off their prescribed path", worst);
     CHECK(ok && moved > 0.5 * pr.velocity[0] * pr.duration, "the beam does not follow its end (%g m)", moved);
-done:
     test_setup_free(&s);
     free(q0);
     free(group);
 }
 
+/* Driven rotation with the paper's linearly implicit step: the x = 0 end cap of a
+ * 3-section beam turns about the beam's axis at a constant rate (zero gravity) and the
+ * whole beam starts with that angular velocity. A rigid rotation is a zero mode of K, so
+ * the free rows of (M + h^2 K) v+ = M v are solved by the rigid velocity only if the
+ * pinned points' velocities enter the right-hand side through the right stiffness block
+ * A_fp (kept for one triangle of group pairs, the other being its transpose). After 0.4 s
+ * (0.2 rad) every free control point of the 1 m wide beam is within 1.5e-4 m of the rigidly rotated
+ * rest position (3.4e-5 measured; the tangential steps drift off the circle). Without
+ * the transposed blocks the worst point is 9e-4 off, without A_fp's stiffness 3.9e-3. */
 static void test_driven_rotation(void)
 {
     sem_error err;
@@ -486,29 +500,9 @@ static void test_driven_rotation(void)
     size_t nc = 0;
     double *q0 = NULL;
     int *group = NULL;
-    if (!make_model(&s, 3, 2, 6)) goto done;
-    nc = sem_model_control_points(s.model);
-    q0 = malloc(3 * nc * sizeof(double));
-    group = malloc(nc * sizeof(int));
-    if (!q0 || !group) goto done;
-    sem_model_get_q(s.model, q0);
-    for (size_t c = 0; c < nc; ++c) group[c] = fabs(q0[3 * c]) < 1e-9 ? 0 : -1;
     sem_prescribe pr = beam_axis_rotation(0.5);
-    sem_world_def wd = sem_default_world_def();
-    wd.gravity[2] = 0;
-    wd.dt = 0.01;
-    s.world = sem_world_create(&wd, &err);
-    sem_object_def od = sem_default_object_def();
-    od.model = s.model;
-    od.disc = s.disc;
-    od.prescribe_group = group;
-    od.prescribes = &pr;
-    od.n_prescribes = 1;
-    od.material.youngs_modulus = 1e7;
-    od.material.density = 1000;
-    od.initial_angular_velocity[0] = pr.rate; /* the whole beam already turns with its cap */
-    int ok = s.world && sem_world_add_object(s.world, &od, &err) == 0;
-    CHECK(ok, "%s", err.message);
+    /* the whole beam already turns with its cap */
+    int ok = driven_beam(&s, &pr, pr.rate, &q0, &group, &nc);
     for (int k = 0; k < 40 && ok; ++k) {
         ok = sem_world_step(s.world, &err) == SEM_OK;
         CHECK(ok, "step %d: %s", k, err.message);
@@ -527,7 +521,6 @@ static void test_driven_rotation(void)
         printf("driven rotation: worst free point %.3e m from the rigid rotation (%.3f rad)\n", worst, ang);
         CHECK(worst < 1.5e-4, "free points are up to %g m off the rigid rotation (beam width 1 m)", worst);
     }
-done:
     test_setup_free(&s);
     free(q0);
     free(group);

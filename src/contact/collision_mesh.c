@@ -74,14 +74,6 @@ static int compare_link(const void *x, const void *y)
     return (a->q > b->q) - (a->q < b->q);
 }
 
-/* Turns parts so that they face away from the object's inside. A part's (u, v) orientation
- * is the modeller's; the signs of distances need outward normals. Parts that share edges
- * are first made consistent with each other (the majority of their shared edges decides),
- * then each group of connected parts is turned as a whole when it encloses a negative volume
- * seen from the surface's point centroid (exact for a closed group; for a part alone it is
- * the heuristic it always was, exact for star-shaped bodies). The preprocessing's own
- * orientation fix is not part of the discretization. Leaves edge_other for the turned
- * triangles. */
 /* Each point's copies (copy_start, copy_point): the points of its weld group on its own part.
  * The weld groups are gathered first (a counting sort by representative), then each point
  * lists the members of its group with its part. */
@@ -130,16 +122,15 @@ static sem_status find_copies(sem_collision_mesh *m, const int *point_part, sem_
 static sem_status merge_copy_rows(sem_collision_mesh *m, sem_error *err)
 {
     const int n = m->n_points;
-    int merged = 0, widest = 0;
+    int widest = 0; /* the most row entries of one point's copies; 0: no point has copies */
     for (int p = 0; p < n; ++p) {
         int count = m->copy_start[p + 1] - m->copy_start[p], entries = 0;
         if (count < 2) continue;
-        merged = 1;
         for (int k = m->copy_start[p]; k < m->copy_start[p + 1]; ++k)
             entries += m->row_start[m->copy_point[k] + 1] - m->row_start[m->copy_point[k]];
         if (entries > widest) widest = entries;
     }
-    if (!merged) return SEM_OK;
+    if (widest == 0) return SEM_OK;
     int *start = malloc(((size_t)n + 1) * sizeof(int)), *ctrl = NULL, *tmp_ctrl = malloc(((size_t)widest + 1) * sizeof(int));
     double *w = NULL, *tmp_w = malloc(((size_t)widest + 1) * sizeof(double));
     size_t total = 0;
@@ -200,6 +191,14 @@ static sem_status merge_copy_rows(sem_collision_mesh *m, sem_error *err)
     return SEM_OK;
 }
 
+/* Turns parts so that they face away from the object's inside. A part's (u, v) orientation
+ * is the modeller's; the signs of distances need outward normals. Parts that share edges
+ * are first made consistent with each other (the majority of their shared edges decides),
+ * then each group of connected parts is turned as a whole when it encloses a negative volume
+ * seen from the surface's point centroid (exact for a closed group; for a part alone it is
+ * the heuristic it always was, exact for star-shaped bodies). The preprocessing's own
+ * orientation fix is not part of the discretization. Leaves edge_other for the turned
+ * triangles. */
 static sem_status orient_parts(sem_collision_mesh *m, const sem_mesh *mesh, sem_error *err)
 {
     int np = mesh->n_parts, nt = m->n_triangles;

@@ -71,18 +71,18 @@ sem_status sem_loads_gravity(sem_object *o, const double g[3], sem_error *err)
 
 void sem_prescription_apply(const sem_prescribe *pr, double t, const double x0[3], double out[3])
 {
+    /* rotate and move stop at their duration */
+    const double tt = pr->duration > 0 && t > pr->duration ? pr->duration : t;
     if (pr->type == SEM_PRESCRIBE_AFFINE) {
         const double *A = pr->affine;
         for (int r = 0; r < 3; ++r) out[r] = A[4 * r] * x0[0] + A[4 * r + 1] * x0[1] + A[4 * r + 2] * x0[2] + A[4 * r + 3];
         return;
     }
     if (pr->type == SEM_PRESCRIBE_MOVE) {
-        double tt = pr->duration > 0 && t > pr->duration ? pr->duration : t;
         for (int i = 0; i < 3; ++i) out[i] = x0[i] + pr->velocity[i] * tt;
         return;
     }
     if (pr->type == SEM_PRESCRIBE_ROTATE) {
-        double tt = pr->duration > 0 && t > pr->duration ? pr->duration : t;
         double ang = pr->rate * tt;
         double k[3] = {pr->axis_direction[0], pr->axis_direction[1], pr->axis_direction[2]};
         double kn = sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);

@@ -279,9 +279,9 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
             break;
         }
         full_steps = step == 1.0 ? full_steps + 1 : 0;
-        double dmax = 0, dir_max = 0;
+        double dir_max = 0; /* the Newton step's largest move; the step taken is step x it */
         for (size_t i = 0; i < n; ++i) dir_max = fmax(dir_max, fabs(dir[i]));
-        dmax = step * dir_max;
+        const double dmax = step * dir_max;
         if (w->def.advanced.trace_newton && w->def.log) {
             char line[256];
             snprintf(line, sizeof line, "newton it %d: |g| %.6g dE %.6g step %g slope %g dmax %g", it, gnorm,
