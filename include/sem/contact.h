@@ -24,6 +24,18 @@
 extern "C" {
 #endif
 
+/* How surfaces are kept apart (sem_contact_def.model). */
+typedef enum sem_contact_model {
+    /* Penalty springs on the collision points (the default): cheap; a point may sink a
+     * little into what it presses on, and a fast or thin one can pass through. */
+    SEM_CONTACT_PENALTY,
+    /* IPC's log barrier on the distances between the collision surfaces (points against
+     * triangles, edges against edges), with a continuous collision check that bounds every
+     * Newton step: surfaces never cross (Li et al. 2020; docs/simulation.md). Implicit Euler
+     * and statics only. */
+    SEM_CONTACT_BARRIER
+} sem_contact_model;
+
 /* Contact settings of a world (zero: the defaults). */
 typedef struct sem_contact_def {
     /* Penalty stiffness per unit area (N/m^3: the contact pressure per metre of
@@ -33,7 +45,8 @@ typedef struct sem_contact_def {
      * body they stop). */
     double stiffness;
     /* Distance from a surface at which the springs start (m); <= 0: 1e-3 L of each object.
-     * A resting object floats about this far above what it rests on. */
+     * A resting object floats about this far above what it rests on. The barrier model's
+     * reach dhat (its surfaces feel each other from this distance on). */
     double thickness;
     /* Self-contact: an object's surface is kept out of itself, away from where it meets
      * itself at rest (a point never collides with its own surface within twice the search
@@ -48,6 +61,7 @@ typedef struct sem_contact_def {
     /* Collision tessellation: cells per knot span and direction; <= 0: chosen per model so
      * that the points are no farther apart than about 1/16 of its size (2..16). */
     int resolution;
+    sem_contact_model model;
 } sem_contact_def;
 
 typedef enum sem_collider_type {
@@ -76,7 +90,9 @@ typedef struct sem_contact_stats {
     int contacts;     /* contact points pushed at the end of the last step */
     int self_contacts; /* of which against their own object's surface (self-contact) */
     double min_gap;   /* smallest signed distance of a collision point to another surface
-                         it is near (m; negative: penetration); +inf when none is near */
+                         it is near (m; negative: penetration); +inf when none is near. The
+                         barrier model: the smallest distance of its pairs (points against
+                         triangles, edges against edges), never <= 0 */
     double seconds;   /* wall time of the last step spent in contact */
     int colliders;
 } sem_contact_stats;

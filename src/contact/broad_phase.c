@@ -29,7 +29,15 @@ static int compare_keyed(const void *a, const void *b)
     return (x->triangle > y->triangle) - (x->triangle < y->triangle);
 }
 
+static void node_box2(sem_bvh *bvh, int node, const double *vertices, const double *moved, const int *triangles);
+
 static void node_box(sem_bvh *bvh, int node, const double *vertices, const int *triangles)
+{
+    node_box2(bvh, node, vertices, NULL, triangles);
+}
+
+/* The node's box over the triangles' vertices at both positions (moved may be NULL) */
+static void node_box2(sem_bvh *bvh, int node, const double *vertices, const double *moved, const int *triangles)
 {
     sem_bvh_node *n = &bvh->nodes[node];
     for (int k = 0; k < 3; ++k) {
@@ -49,6 +57,10 @@ static void node_box(sem_bvh *bvh, int node, const double *vertices, const int *
         for (int v = 0; v < 3; ++v)
             for (int k = 0; k < 3; ++k) {
                 double x = vertices[3 * (size_t)tri[v] + k];
+                if (x < n->lo[k]) n->lo[k] = x;
+                if (x > n->hi[k]) n->hi[k] = x;
+                if (!moved) continue;
+                x = moved[3 * (size_t)tri[v] + k];
                 if (x < n->lo[k]) n->lo[k] = x;
                 if (x > n->hi[k]) n->hi[k] = x;
             }
@@ -126,6 +138,32 @@ sem_status sem_bvh_build(sem_bvh *bvh, const double *vertices, const int *triang
 void sem_bvh_refit(sem_bvh *bvh, const double *vertices, const int *triangles)
 {
     for (int node = bvh->n_nodes - 1; node >= 0; --node) node_box(bvh, node, vertices, triangles);
+}
+
+void sem_bvh_refit_swept(sem_bvh *bvh, const double *x0, const double *x1, const int *triangles)
+{
+    for (int node = bvh->n_nodes - 1; node >= 0; --node) node_box2(bvh, node, x0, x1, triangles);
+}
+
+void sem_bvh_overlap(const sem_bvh *bvh, const double lo[3], const double hi[3], void (*visit)(int triangle, void *context),
+                     void *context)
+{
+    if (bvh->n_triangles <= 0) return;
+    int stack[128], top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const sem_bvh_node *n = &bvh->nodes[stack[--top]];
+        int meets = 1;
+        for (int k = 0; k < 3; ++k) meets &= n->lo[k] <= hi[k] && lo[k] <= n->hi[k];
+        if (!meets) continue;
+        if (n->left < 0) {
+            for (int t = n->first; t < n->first + n->count; ++t) visit(bvh->order[t], context);
+            continue;
+        }
+        if (top + 2 > 128) continue; /* depth is about log2(n / 4): never reached */
+        stack[top++] = n->right;
+        stack[top++] = n->left;
+    }
 }
 
 void sem_bvh_free(sem_bvh *bvh)

@@ -32,6 +32,13 @@ sem_status sem_bvh_build(sem_bvh *bvh, const double *vertices, const int *triang
                          sem_error *err);
 /* New boxes for moved vertices (same triangles). */
 void sem_bvh_refit(sem_bvh *bvh, const double *vertices, const int *triangles);
+/* Boxes that hold each triangle at both vertex positions x0 and x1 (x1 NULL: x0 only) and
+ * all of the straight motion between them (continuous collision detection, ccd.h). */
+void sem_bvh_refit_swept(sem_bvh *bvh, const double *x0, const double *x1, const int *triangles);
+/* Calls visit(triangle, context) for every triangle of a leaf whose box meets the box
+ * [lo, hi], in the tree's order (the caller tests the triangle itself). */
+void sem_bvh_overlap(const sem_bvh *bvh, const double lo[3], const double hi[3], void (*visit)(int triangle, void *context),
+                     void *context);
 void sem_bvh_free(sem_bvh *bvh);
 /* The triangle nearest p with squared distance < max_dist2, or -1; *out its closest point. */
 int sem_bvh_closest(const sem_bvh *bvh, const double *vertices, const int *triangles, const double p[3],

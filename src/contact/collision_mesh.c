@@ -295,8 +295,7 @@ done:
     return st;
 }
 
-/* x = J q for every point */
-static void update_positions(sem_collision_mesh *m, const double *q)
+void sem_collision_mesh_positions(const sem_collision_mesh *m, const double *q, double *out)
 {
     for (int p = 0; p < m->n_points; ++p) {
         double x[3] = {0, 0, 0};
@@ -304,9 +303,12 @@ static void update_positions(sem_collision_mesh *m, const double *q)
             const double *qc = q + 3 * (size_t)m->row_ctrl[e];
             for (int k = 0; k < 3; ++k) x[k] += m->row_w[e] * qc[k];
         }
-        memcpy(m->x + 3 * (size_t)p, x, sizeof x);
+        memcpy(out + 3 * (size_t)p, x, sizeof x);
     }
 }
+
+/* x = J q for every point */
+static void update_positions(sem_collision_mesh *m, const double *q) { sem_collision_mesh_positions(m, q, m->x); }
 
 /* Face normals at the current x, and each corner's angle x its face normal summed at its
  * welded point (the angle-weighted pseudonormal) */
@@ -342,8 +344,9 @@ static void update_normals(sem_collision_mesh *m)
 void sem_collision_mesh_free(sem_collision_mesh *m)
 {
     SEM_FREE_ALL(m->row_start, m->row_ctrl, m->row_w, m->area, m->triangles, m->x, m->x0, m->pseudo_normal,
-                 m->face_normal, m->weld, m->edge_other, m->copy_start, m->copy_point);
+                 m->face_normal, m->weld, m->edge_other, m->copy_start, m->copy_point, m->edge_tri);
     sem_bvh_free(&m->bvh);
+    sem_bvh_free(&m->edge_bvh);
     memset(m, 0, sizeof *m);
 }
 
@@ -449,7 +452,11 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
     out->x0 = malloc(3 * (size_t)out->n_points * sizeof(double) + 1);
     if (!out->x0) goto nomem;
     memcpy(out->x0, out->x, 3 * (size_t)out->n_points * sizeof(double));
-    st = sem_bvh_build(&out->bvh, out->x, out->triangles, out->n_triangles, err);
+    if ((st = sem_bvh_build(&out->bvh, out->x, out->triangles, out->n_triangles, err)) != SEM_OK) goto done;
+    if ((st = sem_collision_edges(out->triangles, out->n_triangles, out->weld, &out->edge_tri, &out->n_edges, err)) !=
+        SEM_OK)
+        goto done;
+    st = sem_bvh_build(&out->edge_bvh, out->x, out->edge_tri, out->n_edges, err);
     goto done;
 nomem:
     st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory for a collision mesh");

@@ -44,6 +44,9 @@ typedef struct sem_collision_mesh {
     double length;         /* bounding-box diagonal at rest */
     int resolution;        /* tessellation cells per knot span used */
     sem_bvh bvh;           /* over the triangles at the last update */
+    int n_edges;           /* the triangles' edges once each, collapsed ones left out: */
+    int *edge_tri;         /* 3 per edge, its ends a, b and b again (a triangle for edge_bvh) */
+    sem_bvh edge_bvh;      /* over the edges (the barrier's edge pairs; its user refits it) */
 } sem_collision_mesh;
 
 /* The mesh of a model (rest control points q0 = the model's). resolution <= 0: the
@@ -52,10 +55,12 @@ sem_status sem_collision_mesh_build(const sem_model *model, int resolution, sem_
                                     sem_error *err);
 void sem_collision_mesh_free(sem_collision_mesh *m);
 /* x = J q for every point; with between (contact between objects or of an object with
- * itself, the only users of the normals and of this mesh's tree) also the face and vertex
- * normals and the tree's boxes.
+ * itself, or the barrier: the users of the normals and of this mesh's tree) also the face
+ * and vertex normals and the triangle tree's boxes.
  * The mesh as built has normals at the rest shape. */
 void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int between);
+/* out = J q (3 per point), the positions alone. */
+void sem_collision_mesh_positions(const sem_collision_mesh *m, const double *q, double *out);
 /* The outward direction at the closest feature of triangle t (narrow_phase.h: feature,
  * index): its normal, the sum of the normals on either side of an edge, or the vertex's
  * pseudonormal. */

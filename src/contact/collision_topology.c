@@ -46,3 +46,33 @@ sem_status sem_collision_edge_neighbours(const int *triangles, int n_triangles, 
     free(edges);
     return SEM_OK;
 }
+
+sem_status sem_collision_edges(const int *triangles, int n_triangles, const int *weld, int **out, int *n_edges,
+                               sem_error *err)
+{
+    size_t n = 3 * (size_t)(n_triangles > 0 ? n_triangles : 0);
+    sem_edge_slot *e = malloc((n + 1) * sizeof *e);
+    int *edges = malloc((3 * n + 1) * sizeof(int));
+    if (!e || !edges) {
+        free(e);
+        free(edges);
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for collision edges");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        int p = triangles[i], q = triangles[i - i % 3 + (i % 3 + 1) % 3];
+        e[i] = (sem_edge_slot){p < q ? p : q, p < q ? q : p, (int)i};
+    }
+    qsort(e, n, sizeof *e, sem_compare_edge_slot);
+    int count = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (i > 0 && e[i].a == e[i - 1].a && e[i].b == e[i - 1].b) continue;
+        if (e[i].a == e[i].b || (weld && weld[e[i].a] == weld[e[i].b])) continue;
+        edges[3 * count] = e[i].a;
+        edges[3 * count + 1] = edges[3 * count + 2] = e[i].b;
+        ++count;
+    }
+    free(e);
+    *out = edges;
+    *n_edges = count;
+    return SEM_OK;
+}

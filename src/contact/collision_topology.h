@@ -28,4 +28,10 @@ int sem_compare_edge_slot(const void *x, const void *y);
 sem_status sem_collision_edge_neighbours(const int *triangles, int n_triangles, const int *weld, int *edge_other,
                                          sem_error *err);
 
+/* The mesh's edges, once each (by their two point indices), as BVH triangles (a, b, b):
+ * 3 ints per edge in *out (malloc'd), *n_edges of them; edges whose ends are one welded
+ * point (weld may be NULL) are left out. */
+sem_status sem_collision_edges(const int *triangles, int n_triangles, const int *weld, int **out, int *n_edges,
+                               sem_error *err);
+
 #endif

@@ -2,7 +2,7 @@
  * contact_world.c - colliders, detection, and the contact potential of a world's system
  * (see contact_world.h; the springs in penalty.c, friction in friction.c).
  */
-#include "contact_world.h"
+#include "contact_internal.h"
 
 #include <limits.h>
 #include <math.h>
@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact/barrier.h"
 #include "contact/collision_mesh.h"
 #include "contact/collision_topology.h"
 #include "contact/friction.h"
@@ -18,87 +19,6 @@
 #include "util/free_all.h"
 #include "util/grow.h"
 #include "util/union_find.h"
-
-/* Default penalty stiffness per area: KAPPA E / L (see sem_contact_def.stiffness). */
-#define KAPPA 1000.0
-#define DEFAULT_THICKNESS 1e-3     /* x L */
-#define SEARCH_DEPTH 0.05          /* x L: how deep a point may be and still be pushed out */
-#define DEFAULT_FRICTION_VELOCITY 1e-3
-#define MAX_WEIGHTS 192            /* a point's row plus a triangle's three rows */
-/* Self-contact's exclusion rule: a point never collides with the part of its own object's
- * surface that lies within SELF_EXCLUSION x the search radius of it at rest (its own
- * neighbourhood, the other sheet of a thin wall, the other side of a seam). Twice the
- * search radius: at rest no point is within reach of a surface it may collide with. */
-#define SELF_EXCLUSION 2.0
-
-typedef struct collider {
-    sem_collider_type type;
-    double point[3], normal[3];
-    double friction;
-    int n_vertices, n_triangles;
-    double *vertices;
-    int *triangles;
-    double *face_normal;   /* unit, per triangle */
-    double *edge_normal;   /* per triangle edge (3 per triangle): sum of the faces' normals */
-    double *vertex_normal; /* angle-weighted pseudonormal (Baerentzen and Aanaes 2005) */
-    sem_bvh bvh;
-} collider;
-
-typedef struct contact_object {
-    const sem_object *object;
-    int built;               /* mesh and the numbers below (mesh_for) */
-    sem_collision_mesh mesh;
-    double youngs, friction, length, thickness;
-    int self_far;            /* at the last detection no point can reach its own surface
-                              * beyond the exclusion rule (self_far_apart): no self query */
-} contact_object;
-
-/* An active contact: point `point` of system object k against a collider or a triangle of
- * system object `other`. */
-typedef struct contact_rec {
-    int k, point, other, collider, triangle;
-    double bary[3];
-    double d, n[3];          /* signed distance and its gradient */
-    double stiffness, thickness, mu;
-} contact_rec;
-
-/* A friction contact fixed at the start of a step (friction.h). */
-typedef struct friction_rec {
-    int first, count;        /* weights */
-    double T[6], X0[3], mu_lambda;
-    double u_last[2];
-    signed char slipping;    /* at the last iterate with a Hessian: 1, 0; -1: none yet */
-} friction_rec;
-
-struct sem_contact {
-    sem_contact_def def;
-    int n_colliders, cap_colliders;
-    collider *colliders;
-    int n_objects, cap_objects;
-    contact_object *objects;
-    /* per evaluation */
-    int n_recs, cap_recs;
-    contact_rec *recs;
-    contact_rec *slots;      /* detection scratch: per point of an object, its contacts */
-    int *slot_count;
-    size_t cap_slots;
-    int cap_count;
-    int *sys_to_contact;     /* system object -> contact object */
-    int n_sys;
-    double min_gap;
-    sem_point_terms terms;   /* Hessian of the last sem_contact_potential with a gradient */
-    sem_point_terms friction_terms;
-    /* friction of the current step */
-    int n_friction, cap_friction;
-    friction_rec *friction;
-    int n_fweights, cap_fweights;
-    sem_point_weight *fweights;
-    double friction_eps;     /* eps_v h of the step; 0: no friction */
-    int n_couplings, cap_couplings;
-    sem_system_coupling *couplings; /* the blocks contact between objects needs */
-    long rebuilds;           /* systems made again for new coupling blocks */
-    sem_contact_stats stats;
-};
 
 /* ---------------------------------------------------------------------------------- */
 /* life cycle                                                                          */
@@ -111,6 +31,8 @@ sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem
     if (def->self < -1 || def->self > 1)
         return sem_error_set(err, SEM_ERR_INVALID, "contact: self must be -1 (off), 0 (the default: on) or 1 (got %d)",
                              def->self);
+    if (def->model != SEM_CONTACT_PENALTY && def->model != SEM_CONTACT_BARRIER)
+        return sem_error_set(err, SEM_ERR_INVALID, "contact: unknown model %d", (int)def->model);
     if (def->resolution > 64)
         return sem_error_set(err, SEM_ERR_INVALID, "contact resolution must be at most 64 (got %d)", def->resolution);
     sem_contact *c = calloc(1, sizeof *c);
@@ -126,17 +48,22 @@ sem_status sem_contact_create(const sem_contact_def *def, sem_contact **out, sem
 
 static void collider_free(collider *k)
 {
-    SEM_FREE_ALL(k->vertices, k->triangles, k->face_normal, k->edge_normal, k->vertex_normal);
+    SEM_FREE_ALL(k->vertices, k->triangles, k->face_normal, k->edge_normal, k->vertex_normal, k->edge_tri, k->mark);
     sem_bvh_free(&k->bvh);
+    sem_bvh_free(&k->edge_bvh);
 }
 
 void sem_contact_destroy(sem_contact *c)
 {
     if (!c) return;
     for (int i = 0; i < c->n_colliders; ++i) collider_free(&c->colliders[i]);
-    for (int i = 0; i < c->n_objects; ++i) sem_collision_mesh_free(&c->objects[i].mesh);
+    for (int i = 0; i < c->n_objects; ++i) {
+        sem_collision_mesh_free(&c->objects[i].mesh);
+        free(c->objects[i].x1);
+    }
     SEM_FREE_ALL(c->colliders, c->objects, c->recs, c->slots, c->slot_count, c->sys_to_contact, c->friction,
-                 c->fweights, c->couplings);
+                 c->fweights, c->couplings, c->pairs, c->candidates);
+    sem_barrier_free_lists(c);
     sem_point_terms_free(&c->terms);
     sem_point_terms_free(&c->friction_terms);
     free(c);
@@ -210,6 +137,8 @@ static sem_status mesh_normals(collider *k, sem_error *err)
     return SEM_OK;
 }
 
+static int def_is_barrier(const sem_contact *c) { return c->def.model == SEM_CONTACT_BARRIER; }
+
 sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def, sem_error *err)
 {
     if (!(def->friction >= 0) || !isfinite(def->friction))
@@ -249,6 +178,7 @@ sem_status sem_contact_add_collider(sem_contact *c, const sem_collider_def *def,
         memcpy(k.triangles, def->triangles, 3 * (size_t)k.n_triangles * sizeof(int));
         sem_status st = mesh_normals(&k, err);
         if (st == SEM_OK) st = sem_bvh_build(&k.bvh, k.vertices, k.triangles, k.n_triangles, err);
+        if (st == SEM_OK && def_is_barrier(c)) st = sem_barrier_collider_edges(&k, err);
         if (st != SEM_OK) {
             collider_free(&k);
             return st;
@@ -277,7 +207,7 @@ sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error
 
 /* The collision mesh of contact object i, built on first use: a world with one object and
  * no collider never pays for it. */
-static sem_status mesh_for(sem_contact *c, int i, sem_error *err)
+sem_status sem_contact_mesh_for(sem_contact *c, int i, sem_error *err)
 {
     contact_object *co = &c->objects[i];
     if (co->built) return SEM_OK;
@@ -299,6 +229,8 @@ void sem_contact_remove_last_object(sem_contact *c)
 
 int sem_contact_between_objects(const sem_contact *c) { return !c->def.disabled && c->n_objects >= 2; }
 
+int sem_contact_barrier(const sem_contact *c) { return def_is_barrier(c) && sem_contact_active(c); }
+
 int sem_contact_active(const sem_contact *c)
 {
     return !c->def.disabled && (c->n_colliders > 0 || c->n_objects >= 2 || (c->def.self > 0 && c->n_objects > 0));
@@ -312,19 +244,19 @@ void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out) { *out 
 /* detection                                                                           */
 
 /* Self-contact on (sem_contact_def.self: 0 the default, on; -1 off). */
-static int self_on(const sem_contact *c) { return !c->def.disabled && c->def.self >= 0; }
+int sem_contact_self_on(const sem_contact *c) { return !c->def.disabled && c->def.self >= 0; }
 
 /* Is triangle t of the mesh collapsed (two corners one welded point: at a sphere's pole, a
  * cone's tip)? Its copies share one row (collision_mesh.c), so it stays a segment with no
  * normal to sign a distance by; its neighbours, which share that segment, stand in. */
-static int collapsed(const sem_collision_mesh *m, int t)
+int sem_contact_collapsed(const sem_collision_mesh *m, int t)
 {
     const int *v = m->triangles + 3 * (size_t)t;
     int a = m->weld[v[0]], b = m->weld[v[1]], c = m->weld[v[2]];
     return a == b || b == c || a == c;
 }
 
-static int collapsed_excluded(int t, void *context) { return collapsed(context, t); }
+static int collapsed_excluded(int t, void *context) { return sem_contact_collapsed(context, t); }
 
 /* Self-contact's exclusion rule (SELF_EXCLUSION): is triangle t of the mesh within the
  * excluded rest distance of the point? */
@@ -337,7 +269,7 @@ typedef struct self_exclusion {
 static int self_excluded(int t, void *context)
 {
     const self_exclusion *e = context;
-    if (collapsed(e->mesh, t)) return 1;
+    if (sem_contact_collapsed(e->mesh, t)) return 1;
     const int *v = e->mesh->triangles + 3 * (size_t)t;
     const double *x0 = e->mesh->x0;
     sem_tri_closest cl;
@@ -360,7 +292,7 @@ static double det3(const double *a)
  * rotation makes the bound true, a good one makes it tight. A falling or tumbling object that
  * hardly deforms then pays O(n) per detection for self-contact instead of a tree query per
  * point. 0 when the test cannot tell (a flat or degenerate mesh): the queries run. */
-static int self_far_apart(const sem_collision_mesh *m, double radius)
+int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius)
 {
     int n = m->n_points;
     if (n <= 0) return 1;
@@ -420,7 +352,7 @@ static int self_far_apart(const sem_collision_mesh *m, double radius)
 }
 
 /* contact_object of each of the system's objects */
-static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err)
+sem_status sem_contact_map_system(sem_contact *c, const sem_system *s, sem_error *err)
 {
     if (c->n_sys < s->n_objects) {
         int *x = realloc(c->sys_to_contact, (size_t)s->n_objects * sizeof *x);
@@ -434,7 +366,7 @@ static sem_status map_system(sem_contact *c, const sem_system *s, sem_error *err
             if (c->objects[i].object == s->objects[k]) c->sys_to_contact[k] = i;
         if (c->sys_to_contact[k] < 0)
             return sem_error_set(err, SEM_ERR_INVALID, "contact: an object of the system is not in the world");
-        sem_status st = mesh_for(c, c->sys_to_contact[k], err);
+        sem_status st = sem_contact_mesh_for(c, c->sys_to_contact[k], err);
         if (st != SEM_OK) return st;
     }
     return SEM_OK;
@@ -486,7 +418,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         r.mu = sqrt(co->friction * col->friction);
         out[n++] = r;
     }
-    if (self_on(c) && !co->self_far) {
+    if (sem_contact_self_on(c) && !co->self_far) {
         /* the object's own surface beyond the exclusion rule; within the search radius only
          * (self-contact needs no coupling blocks, the margin's only use) */
         self_exclusion ex = {m, m->x0 + 3 * (size_t)p, SELF_EXCLUSION * SELF_EXCLUSION * radius * radius};
@@ -541,18 +473,18 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
  * list is the same on any thread count. */
 static sem_status detect(sem_contact *c, const sem_system *s, const double *q, double margin, sem_error *err)
 {
-    sem_status st = map_system(c, s, err);
+    sem_status st = sem_contact_map_system(c, s, err);
     if (st != SEM_OK) return st;
     c->n_recs = 0;
     c->min_gap = INFINITY;
     if (c->def.disabled) return SEM_OK;
-    int between = s->n_objects >= 2 || self_on(c);
+    int between = s->n_objects >= 2 || sem_contact_self_on(c);
     for (int k = 0; k < s->n_objects; ++k)
         sem_collision_mesh_update(&c->objects[c->sys_to_contact[k]].mesh, q + s->dof_offset[k], between);
-    int per_point = c->n_colliders + s->n_objects - 1 + self_on(c);
-    for (int k = 0; k < s->n_objects && self_on(c); ++k) {
+    int per_point = c->n_colliders + s->n_objects - 1 + sem_contact_self_on(c);
+    for (int k = 0; k < s->n_objects && sem_contact_self_on(c); ++k) {
         contact_object *co = &c->objects[c->sys_to_contact[k]];
-        co->self_far = self_far_apart(&co->mesh, co->thickness + SEARCH_DEPTH * co->length);
+        co->self_far = sem_contact_self_far_apart(&co->mesh, co->thickness + SEARCH_DEPTH * co->length);
     }
     if (per_point <= 0) return SEM_OK;
     int nthreads = s->n_objects > 0 ? s->objects[0]->nthreads : 1;
@@ -607,7 +539,7 @@ static int rec_weights(const sem_contact *c, const contact_rec *r, sem_point_wei
     return n;
 }
 
-static void add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad)
+void sem_contact_add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad)
 {
     for (int i = 0; i < n; ++i) {
         double *g = grad + s->dof_offset[w[i].object] + 3 * (size_t)w[i].ctrl;
@@ -615,7 +547,7 @@ static void add_gradient(const sem_system *s, const sem_point_weight *w, int n, 
     }
 }
 
-static void relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
+void sem_contact_relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
 {
     X[0] = X[1] = X[2] = 0;
     for (int i = 0; i < n; ++i) {
@@ -643,7 +575,7 @@ static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem
         if (v && !(r->d < r->thickness)) {
             double X[3];
             n = rec_weights(c, r, w);
-            relative_point(s, w, n, v, X);
+            sem_contact_relative_point(s, w, n, v, X);
             if (!(r->d + h * dot3(X, r->n) < r->thickness)) continue;
             slope = r->stiffness * (r->d - r->thickness);
         } else if (!(r->d < r->thickness))
@@ -651,7 +583,7 @@ static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem
         if (!grad) continue;
         if (n == 0) n = rec_weights(c, r, w);
         double f[3] = {slope * r->n[0], slope * r->n[1], slope * r->n[2]};
-        add_gradient(s, w, n, f, grad);
+        sem_contact_add_gradient(s, w, n, f, grad);
         double H[9] = {0};
         sem_penalty_hessian(r->stiffness, r->n, H);
         sem_status st = sem_point_terms_push(terms, w, n, H, err);
@@ -674,7 +606,7 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
         friction_rec *fr = &c->friction[i];
         const sem_point_weight *w = c->fweights + fr->first;
         double X[3], u[2], g[2], Hu[4];
-        relative_point(s, w, fr->count, q, X);
+        sem_contact_relative_point(s, w, fr->count, q, X);
         for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
         u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
         u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
@@ -701,7 +633,7 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
                 H[3 * a + b] = ta0 * (Hu[0] * tb0 + Hu[1] * tb1) + ta1 * (Hu[2] * tb0 + Hu[3] * tb1);
             }
         }
-        add_gradient(s, w, fr->count, f, grad);
+        sem_contact_add_gradient(s, w, fr->count, f, grad);
         sem_status st = sem_point_terms_push(terms, w, fr->count, H, err);
         if (st != SEM_OK) return st;
     }
@@ -725,7 +657,7 @@ static sem_status friction_damper(sem_contact *c, const sem_system *s, const dou
         const friction_rec *fr = &c->friction[i];
         const sem_point_weight *w = c->fweights + fr->first;
         double X[3], u[2], g[2];
-        relative_point(s, w, fr->count, qpred, X);
+        sem_contact_relative_point(s, w, fr->count, qpred, X);
         for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
         u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
         u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
@@ -761,30 +693,51 @@ static double *system_q(const sem_system *s, double a, double b)
 /* ---------------------------------------------------------------------------------- */
 /* the step                                                                            */
 
+sem_status sem_contact_need_coupling(sem_contact *c, const sem_system *s, int a, int pa, int b, int pb,
+                                     sem_error *err)
+{
+    const sem_collision_mesh *m = &c->objects[c->sys_to_contact[a]].mesh;
+    const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[b]].mesh;
+    int ga = s->objects[a]->ctrl_group[m->row_ctrl[m->row_start[pa]]];
+    int gb = s->objects[b]->ctrl_group[mo->row_ctrl[mo->row_start[pb]]];
+    sem_system_coupling cp = a < b ? (sem_system_coupling){a, ga, b, gb} : (sem_system_coupling){b, gb, a, ga};
+    for (int j = 0; j < c->n_couplings; ++j)
+        if (!memcmp(&c->couplings[j], &cp, sizeof cp)) return SEM_OK;
+    if (!sem_grow((void **)&c->couplings, &c->cap_couplings, c->n_couplings + 1, sizeof *c->couplings, 64, INT_MAX))
+        return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    c->couplings[c->n_couplings++] = cp;
+    return SEM_OK;
+}
+
 /* The coupling blocks contact between objects needs at q (contacts within the search
- * radius: a superset of those a step's iterates can activate), in c->couplings. */
+ * radius, or the barrier's pairs within its margin: a superset of those a step's iterates
+ * can activate), in c->couplings. */
 static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_error *err)
 {
     c->n_couplings = 0;
-    for (int i = 0; i < c->n_recs; ++i) {
+    sem_status st = SEM_OK;
+    for (int i = 0; i < c->n_recs && st == SEM_OK && !def_is_barrier(c); ++i) {
         const contact_rec *r = &c->recs[i];
         if (r->other < 0 || r->other == r->k) continue; /* self-contact: the object's own blocks */
-        const sem_collision_mesh *m = &c->objects[c->sys_to_contact[r->k]].mesh;
         const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
-        int ga = s->objects[r->k]->ctrl_group[m->row_ctrl[m->row_start[r->point]]];
-        int p = mo->triangles[3 * r->triangle];
-        int gb = s->objects[r->other]->ctrl_group[mo->row_ctrl[mo->row_start[p]]];
-        sem_system_coupling cp = r->k < r->other ? (sem_system_coupling){r->k, ga, r->other, gb}
-                                                 : (sem_system_coupling){r->other, gb, r->k, ga};
-        int seen = 0;
-        for (int j = 0; j < c->n_couplings && !seen; ++j)
-            seen = !memcmp(&c->couplings[j], &cp, sizeof cp);
-        if (seen) continue;
-        if (!sem_grow((void **)&c->couplings, &c->cap_couplings, c->n_couplings + 1, sizeof *c->couplings, 64, INT_MAX))
-            return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-        c->couplings[c->n_couplings++] = cp;
+        st = sem_contact_need_coupling(c, s, r->k, r->point, r->other, mo->triangles[3 * r->triangle], err);
     }
-    return SEM_OK;
+    for (int i = 0; i < c->n_pairs && st == SEM_OK && def_is_barrier(c); ++i) {
+        const barrier_pair *p = &c->pairs[i];
+        for (int u = 0; u < p->nv && st == SEM_OK; ++u)
+            for (int v = u + 1; v < p->nv && st == SEM_OK; ++v)
+                if (p->object[u] >= 0 && p->object[v] >= 0 && p->object[u] != p->object[v])
+                    st = sem_contact_need_coupling(c, s, p->object[u], p->point[u], p->object[v], p->point[v], err);
+    }
+    return st;
+}
+
+/* The step's contacts at q: the springs' (margin x the search radius beyond the thickness)
+ * or the barrier's pairs (within margin x its reach, at least 1). */
+static sem_status detect_any(sem_contact *c, const sem_system *s, const double *q, double margin, sem_error *err)
+{
+    if (def_is_barrier(c)) return sem_barrier_detect(c, s, q, margin, err);
+    return detect(c, s, q, margin, err);
 }
 
 sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h, sem_solver_choice solver,
@@ -805,7 +758,12 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
     if (!q) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    sem_status st = detect(c, s, q, s->n_objects > 1 ? 1 : 0, err);
+    sem_status st = detect_any(c, s, q, s->n_objects > 1 ? 1 : 0, err);
+    if (st == SEM_OK && def_is_barrier(c) && !(c->min_gap > 0))
+        st = sem_error_set(err, SEM_ERR_NUMERIC,
+                           "contact (barrier): two surfaces touch or cross at the start of a step (distance %g m); "
+                           "the barrier model needs them apart",
+                           c->min_gap);
     /* objects near each other: their coupling blocks in the system's pattern (a new system
      * when some are missing; point_terms.h) */
     if (st == SEM_OK && s->n_objects > 1) st = needed_couplings(c, s, err);
@@ -817,8 +775,8 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         if (missing) {
             /* ask for the blocks of parts up to three search radii apart, so that objects
              * approaching each other do not need a new system every step */
-            if ((st = detect(c, s, q, 3, err)) == SEM_OK) st = needed_couplings(c, s, err);
-            if (st == SEM_OK) st = detect(c, s, q, 1, err); /* the step's contacts again */
+            if ((st = detect_any(c, s, q, 3, err)) == SEM_OK) st = needed_couplings(c, s, err);
+            if (st == SEM_OK) st = detect_any(c, s, q, 1, err); /* the step's contacts again */
         }
         if (missing && st == SEM_OK) {
             sem_system *ns = NULL;
@@ -834,11 +792,28 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
     }
     c->friction_eps = h > 0 ? c->def.friction_velocity * h : 0;
     sem_point_weight w[MAX_WEIGHTS];
-    for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < c->n_recs; ++i) {
-        const contact_rec *r = &c->recs[i];
-        double lambda = r->stiffness * (r->thickness - r->d);
-        if (!(r->mu > 0) || !(lambda > 0)) continue;
-        int n = rec_weights(c, r, w);
+    int barrier = def_is_barrier(c), n_contacts = barrier ? c->n_pairs : c->n_recs;
+    for (int i = 0; st == SEM_OK && c->friction_eps > 0 && i < n_contacts; ++i) {
+        double lambda, mu, normal[3];
+        int n;
+        if (barrier) {
+            /* the barrier's force on the pair: kappa m |b'(d)| */
+            const barrier_pair *p = &c->pairs[i];
+            double db;
+            sem_barrier(p->d, p->dhat, &db, NULL);
+            lambda = -p->kappa * p->mollifier * db;
+            mu = p->mu;
+            memcpy(normal, p->n, sizeof normal);
+            if (!(mu > 0) || !(lambda > 0)) continue;
+            n = sem_barrier_weights(c, p, w);
+        } else {
+            const contact_rec *r = &c->recs[i];
+            lambda = r->stiffness * (r->thickness - r->d);
+            mu = r->mu;
+            memcpy(normal, r->n, sizeof normal);
+            if (!(mu > 0) || !(lambda > 0)) continue;
+            n = rec_weights(c, r, w);
+        }
         if (!sem_grow((void **)&c->friction, &c->cap_friction, c->n_friction + 1, sizeof *c->friction, 256, INT_MAX) ||
             !sem_grow((void **)&c->fweights, &c->cap_fweights, c->n_fweights + n, sizeof *c->fweights, 4096,
                       INT_MAX)) {
@@ -850,9 +825,9 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         fr->count = n;
         memcpy(c->fweights + c->n_fweights, w, (size_t)n * sizeof *w);
         c->n_fweights += n;
-        sem_tangent_basis(r->n, fr->T);
-        relative_point(s, w, n, q, fr->X0);
-        fr->mu_lambda = r->mu * lambda;
+        sem_tangent_basis(normal, fr->T);
+        sem_contact_relative_point(s, w, n, q, fr->X0);
+        fr->mu_lambda = mu * lambda;
         fr->slipping = -1;
     }
     free(q);
@@ -867,8 +842,14 @@ double sem_contact_potential(sem_contact *c, const sem_system *s, const double *
     if (!sem_contact_active(c)) return 0;
     double t0 = omp_get_wtime();
     double Es = 0, Ef = 0;
-    sem_status st = detect(c, s, q, 0, err);
-    if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, NULL, 0, err);
+    sem_status st;
+    if (def_is_barrier(c)) {
+        st = sem_barrier_detect(c, s, q, 0, err);
+        if (st == SEM_OK) st = sem_barrier_energy(c, s, grad, &c->terms, &Es, err);
+    } else {
+        st = detect(c, s, q, 0, err);
+        if (st == SEM_OK) st = springs(c, s, grad, &c->terms, &Es, NULL, 0, err);
+    }
     if (st == SEM_OK && h > 0) st = friction(c, s, q, grad, &c->terms, &Ef, err);
     c->stats.seconds += omp_get_wtime() - t0;
     return st == SEM_OK ? Es + Ef : NAN;
@@ -877,6 +858,10 @@ double sem_contact_potential(sem_contact *c, const sem_system *s, const double *
 sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, double *rhs, sem_error *err)
 {
     if (!sem_contact_active(c)) return SEM_OK;
+    if (def_is_barrier(c))
+        return sem_error_set(err, SEM_ERR_UNSUPPORTED,
+                             "contact.model \"barrier\" needs integrator.type \"implicit_euler\" or \"static\" (its "
+                             "collision check bounds Newton's steps; the linearly implicit step has none)");
     double t0 = omp_get_wtime();
     sem_status st = SEM_OK;
     double *q = system_q(s, 1, 0), *qpred = system_q(s, 1, h), *v = system_q(s, 0, 1);
@@ -925,7 +910,7 @@ sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n
         for (int k = 0; k < c->n_objects && ci < 0; ++k)
             if (c->objects[k].object == objects[i]) ci = k;
         sem_status st = ci < 0 ? sem_error_set(err, SEM_ERR_INVALID, "contact: an object is not in the world")
-                               : mesh_for(c, ci, err);
+                               : sem_contact_mesh_for(c, ci, err);
         if (st != SEM_OK) {
             free(box);
             return st;
@@ -964,19 +949,37 @@ sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n
     return SEM_OK;
 }
 
-void sem_contact_end_step(sem_contact *c, const sem_system *s)
+sem_status sem_contact_end_step(sem_contact *c, const sem_system *s, sem_error *err)
 {
-    if (!sem_contact_active(c)) return;
+    if (!sem_contact_active(c)) return SEM_OK;
     double t0 = omp_get_wtime();
     double *q = system_q(s, 1, 0);
-    sem_error err;
-    if (q && detect(c, s, q, 0, &err) == SEM_OK) {
+    sem_error ignored;
+    sem_status st = SEM_OK;
+    if (!q)
+        st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    else if (def_is_barrier(c)) {
+        if ((st = sem_barrier_detect(c, s, q, 0, err)) == SEM_OK) {
+            for (int i = 0; i < c->n_pairs; ++i) {
+                const barrier_pair *p = &c->pairs[i];
+                if (!(p->d < p->dhat)) continue;
+                c->stats.contacts++;
+                c->stats.self_contacts += p->nv > 1 && p->object[0] >= 0 && p->object[0] == p->object[p->nv - 1];
+            }
+            c->stats.min_gap = fmin(c->stats.min_gap, c->min_gap);
+            if (!(c->min_gap > 0))
+                st = sem_error_set(err, SEM_ERR_NUMERIC,
+                                   "contact (barrier): two surfaces touch at the end of a step (distance %g m)",
+                                   c->min_gap);
+        }
+    } else if (detect(c, s, q, 0, &ignored) == SEM_OK) {
         c->stats.contacts += c->n_recs;
         for (int i = 0; i < c->n_recs; ++i) c->stats.self_contacts += c->recs[i].other == c->recs[i].k;
         c->stats.min_gap = fmin(c->stats.min_gap, c->min_gap);
     }
     free(q);
     c->stats.seconds += omp_get_wtime() - t0;
+    return st;
 }
 
 sem_collider_def sem_default_collider_def(void)

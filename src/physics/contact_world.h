@@ -15,6 +15,8 @@
  *   sem_contact_linearized    the linearly implicit step: springs at q_n, friction at
  *                             q_n + h v_n, into its matrix and right-hand side
  *   sem_contact_end_step      counts the contacts and the smallest gap at q_{n+1}
+ *   sem_contact_max_step      the barrier model: how much of a Newton step keeps every
+ *                             surface apart (continuous collision check)
  *
  * Detection. Every collision point (collision_mesh.h) is tested against every collider
  * (planes: the signed distance; triangle meshes: the nearest triangle within a search
@@ -70,7 +72,17 @@ const sem_point_terms *sem_contact_terms(const sem_contact *c);
 /* The linearly implicit step: the system's values (already filled) get h^2 (springs +
  * friction) and rhs (full vectors) -h grad + h^2 A_friction v_n. */
 sem_status sem_contact_linearized(sem_contact *c, sem_system *s, double h, double *rhs, sem_error *err);
-void sem_contact_end_step(sem_contact *c, const sem_system *s);
+/* Counts the contacts and the smallest gap at the step's end; the barrier model fails
+ * there if two surfaces touch (which its collision check rules out). */
+sem_status sem_contact_end_step(sem_contact *c, const sem_system *s, sem_error *err);
+
+/* The barrier model (contact.model "barrier", contact_barrier.c): 1 when it is on and
+ * anything can touch. */
+int sem_contact_barrier(const sem_contact *c);
+/* The largest t in [0, 1] such that the system's surfaces, moved linearly from q to
+ * q + t scale dq, touch nowhere on the way (1 without the barrier model). */
+sem_status sem_contact_max_step(sem_contact *c, const sem_system *s, const double *q, const double *dq, double scale,
+                                double *t, sem_error *err);
 void sem_contact_get_stats(const sem_contact *c, sem_contact_stats *out);
 
 #endif

@@ -321,8 +321,8 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
         /* quasi-static: equilibrium with the loads and prescribed motion of t + dt */
         default: st = sem_newton_solve(w, s, 0.0, t1, w->def.newton_max_iterations, err); break;
         }
+        if (st == SEM_OK) st = sem_contact_end_step(w->contact, s, err);
         if (st != SEM_OK) return st;
-        sem_contact_end_step(w->contact, s);
     }
     for (int k = 0; k < w->n_objects; ++k) {
         sem_status st = sem_runaway_check(w->objects[k], w->def.integrator == SEM_STATIC, t1, err);
@@ -344,8 +344,8 @@ sem_status sem_world_solve_static(sem_world *w, sem_error *err)
     for (int i = 0; i < w->n_systems; ++i) {
         sem_status st = sem_contact_begin_step(w->contact, &w->systems[i], 0.0, w->def.solver, err);
         if (st == SEM_OK) st = sem_newton_solve(w, w->systems[i], 0.0, w->time, max_iterations, err);
+        if (st == SEM_OK) st = sem_contact_end_step(w->contact, w->systems[i], err);
         if (st != SEM_OK) return st;
-        sem_contact_end_step(w->contact, w->systems[i]);
     }
     for (int k = 0; k < w->n_objects; ++k) {
         sem_status st = sem_runaway_check(w->objects[k], 1, w->time, err);

@@ -28,6 +28,13 @@
  * NEWTON_STALL_MOVE of its size. */
 #define NEWTON_STALL_ITERATIONS 8
 #define NEWTON_STALL_MOVE 1e-7
+/* The barrier model also stops, as IPC does (Li et al. 2020, Sec. 5: the Newton increment),
+ * when a full Newton step moves no coordinate by more than BARRIER_NEWTON_MOVE of the
+ * system's size: the barrier's Hessian is only its PSD part (contact/barrier.h), so near a
+ * contact at a vertex or edge Newton converges linearly, and its last iterations move the
+ * surfaces by nanometres while the relative gradient is still above 1e-8 (a ball pressed
+ * pole-first onto a plate: 1e-7 m moves at a relative gradient of 1e-6). */
+#define BARRIER_NEWTON_MOVE 1e-7
 
 /* One solve: the world's settings, the system, and its vectors (n_dofs each). */
 typedef struct newton {
@@ -139,6 +146,32 @@ static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, s
     return st;
 }
 
+/* The barrier model's first iterate (q, pinned points at their targets): kept if the
+ * straight move from q_n reaches it without a crossing; otherwise free points start at q_n,
+ * and a crossing then is the pins' (prescribed motion into a surface): an error. scratch:
+ * n_dofs. */
+static sem_status barrier_start(sem_world *w, sem_system *s, double *q, const double *qn, double *scratch, double t1,
+                                sem_error *err)
+{
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t i = 0; i < s->n_dofs; ++i) scratch[i] = q[i] - qn[i];
+        double t = 1;
+        sem_status st = sem_contact_max_step(w->contact, s, qn, scratch, 1.0, &t, err);
+        if (st != SEM_OK || t >= 1) return st;
+        if (pass == 1) break;
+        for (int k = 0; k < s->n_objects; ++k) {
+            const sem_object *o = s->objects[k];
+            size_t off = s->dof_offset[k];
+            for (int c = 0; c < o->n_ctrl; ++c)
+                if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
+        }
+    }
+    return sem_error_set(err, SEM_ERR_NUMERIC,
+                         "contact (barrier): the prescribed motion of pinned points takes a surface into another "
+                         "within the step to t = %g",
+                         t1);
+}
+
 sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, int max_iterations,
                             sem_error *err)
 {
@@ -177,8 +210,19 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         }
     }
     gathered = 1;
-    double qscale = 0;
-    for (size_t i = 0; i < n; ++i) qscale = fmax(qscale, fabs(q[i]));
+    /* the barrier model: the first iterate is reached from q_n without any surface crossing
+     * another (the prediction may carry one through: free points then start at q_n) */
+    int barrier = sem_contact_barrier(w->contact);
+    if (barrier && (st = barrier_start(w, s, q, qn, dir, t1, err)) != SEM_OK) goto done;
+    double qscale = 0, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; ++i) {
+        qscale = fmax(qscale, fabs(q[i]));
+        lo[i % 3] = fmin(lo[i % 3], q[i]);
+        hi[i % 3] = fmax(hi[i % 3], q[i]);
+    }
+    const double size = n >= 3 ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2]))
+                               : 0;
     const newton nt = {w, s, h, cD, t1, dynamic, qn, qpred, f, tmp, dq};
     double g0norm = -1, last_rel = 0, prev_gnorm = INFINITY, slope0 = 0, stall_gnorm = INFINITY;
     int stalled = 0;
@@ -261,6 +305,17 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
         }
         prev_gnorm = gnorm;
         double step = 1.0, dE = INFINITY;
+        if (barrier) {
+            /* the barrier model: no step takes a surface through another (contact_world.h) */
+            double t_max = 1;
+            if ((st = sem_contact_max_step(w->contact, s, q, dir, -1.0, &t_max, err)) != SEM_OK) goto done;
+            if (!(t_max > 0)) {
+                st = sem_error_set(err, SEM_ERR_NUMERIC,
+                                   "contact (barrier): two surfaces touch at t = %g; no step keeps them apart", t1);
+                goto done;
+            }
+            step = t_max;
+        }
         for (int ls = 0; ls < 40; ++ls) {
             for (size_t i = 0; i < n; ++i) qtry[i] = q[i] - step * dir[i];
             dE = nonquadratic(&nt, qtry) - vc0 - step * lin + 0.5 * step * step * curv;
@@ -298,7 +353,8 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
          * (the quadratic model trusted) that moves no coordinate by more than 1e-13 of the
          * largest: q is the solution to the round-off of q itself (an object at rest with
          * nothing acting on it, whose gradient is round-off from its first iteration) */
-        if (dmax <= 1e-14 * (1.0 + fabs(q[0])) || (step == 1.0 && dmax <= 1e-13 * qscale)) {
+        if (dmax <= 1e-14 * (1.0 + fabs(q[0])) || (step == 1.0 && dmax <= 1e-13 * qscale) ||
+            (barrier && step == 1.0 && dmax <= BARRIER_NEWTON_MOVE * size)) {
             ++it;
             converged = 1;
             break;

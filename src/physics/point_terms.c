@@ -43,7 +43,8 @@ sem_status sem_point_terms_push(sem_point_terms *t, const sem_point_weight *weig
 }
 
 /* The (object, group) set of each weight of a term, numbered 0..m-1 in order of first
- * appearance; returns m. */
+ * appearance; returns m. Pinned control points are in no set (-2): they drop out, and a
+ * term whose other side is all pinned (a plate held in place) goes in exactly. */
 static int term_sets(const sem_system *s, const sem_point_term *term, const sem_point_weight *wt,
                      int *set)
 {
@@ -52,9 +53,13 @@ static int term_sets(const sem_system *s, const sem_point_term *term, const sem_
         const sem_point_weight *a = &wt[i];
         int ga = s->objects[a->object]->ctrl_group[a->ctrl];
         set[i] = -1;
+        if (s->objects[a->object]->free_index[a->ctrl] < 0) {
+            set[i] = -2;
+            continue;
+        }
         for (int j = 0; j < i; ++j) {
             const sem_point_weight *b = &wt[j];
-            if (b->object == a->object && s->objects[b->object]->ctrl_group[b->ctrl] == ga) {
+            if (set[j] >= 0 && b->object == a->object && s->objects[b->object]->ctrl_group[b->ctrl] == ga) {
                 set[i] = set[j];
                 break;
             }
@@ -114,7 +119,7 @@ static int term_couplings(const sem_system *s, const sem_point_weight *wt, int c
     int first[MAX_TERM_SETS];
     for (int i = 0; i < m; ++i) first[i] = -1;
     for (int i = 0; i < count; ++i)
-        if (first[set[i]] < 0) first[set[i]] = i;
+        if (set[i] >= 0 && first[set[i]] < 0) first[set[i]] = i;
     for (int i = 0; i < m; ++i)
         for (int j = 0; j < m; ++j) {
             coupling[i * m + j] = -1;
@@ -145,7 +150,7 @@ static void add_terms(sem_system *s, const sem_point_terms *t, double scale, dou
         const sem_point_weight *wt = t->weights + term->first;
         if (term->count > MAX_TERM_WEIGHTS) continue; /* contact's terms have <= 3 x 64 */
         int m = term_sets(s, term, wt, set);
-        int exact = m == 1 || term_couplings(s, wt, term->count, set, m, coupling);
+        int exact = m <= 1 || term_couplings(s, wt, term->count, set, m, coupling);
         double c = scale * (exact ? 1 : m);
         for (int i = 0; i < term->count; ++i) {
             const sem_object *o = s->objects[wt[i].object];

@@ -770,10 +770,15 @@ static sem_status parse_contact(ctx *c, const cJSON *root, sem_contact_def *def)
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "contact");
     if (!o) return SEM_OK;
     static const char *const keys[] = {"enabled", "stiffness", "thickness", "self", "friction_velocity",
-                                       "resolution", NULL};
+                                       "resolution", "model", NULL};
     const char *w = "contact";
     sem_status st = check_keys(c, o, w, keys);
     if (st != SEM_OK) return st;
+    static const char *const models[] = {"penalty", "barrier", NULL};
+    static const int model_values[] = {SEM_CONTACT_PENALTY, SEM_CONTACT_BARRIER};
+    int model = (int)def->model;
+    if ((st = get_choice(c, o, "model", w, models, model_values, &model)) != SEM_OK) return st;
+    def->model = (sem_contact_model)model;
     int enabled = 1;
     if ((st = get_bool(c, o, "enabled", w, &enabled)) != SEM_OK) return st;
     def->disabled = !enabled;
@@ -1068,6 +1073,11 @@ sem_status sem_scene_parse(const char *json, const char *name, const char *base_
     sem_status st = check_keys(&c, root, "scene", keys);
     if (st == SEM_OK) st = parse_world(&c, root, s);
     if (st == SEM_OK) st = parse_contact(&c, root, &s->world.contact);
+    if (st == SEM_OK && s->world.contact.model == SEM_CONTACT_BARRIER &&
+        s->world.integrator == SEM_LINEARLY_IMPLICIT_EULER)
+        st = fail(&c, "contact.model",
+                  "\"barrier\" needs integrator.type \"implicit_euler\" or \"static\" (its collision check bounds "
+                  "Newton's steps; the linearly implicit step takes one unchecked step)");
     if (st == SEM_OK) st = parse_colliders(&c, root, base_dir, s);
     const cJSON *objs = cJSON_GetObjectItemCaseSensitive(root, "objects");
     if (st == SEM_OK && (!cJSON_IsArray(objs) || cJSON_GetArraySize(objs) == 0))
