@@ -128,7 +128,8 @@ class sem_world_advanced(Structure):
 class sem_contact_def(Structure):
     _c_header_ = "contact.h"
     _fields_ = [("stiffness", c_double), ("thickness", c_double), ("self", c_int),
-                ("disabled", c_int), ("friction_velocity", c_double), ("resolution", c_int)]
+                ("disabled", c_int), ("friction_velocity", c_double), ("resolution", c_int),
+                ("model", c_int)]
 
 
 class sem_world_def(Structure):
