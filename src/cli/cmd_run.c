@@ -726,6 +726,7 @@ int cmd_run(int argc, char **argv)
     int stopped_after = -1; /* last complete frame when a signal stopped the run */
     for (int f = first; f <= r.scene->frames && !failure[0]; ++f) {
         int done_in_frame = 0;
+        double frame_gap = INFINITY; /* the smallest gap over the frame's steps */
         for (int s = 0; s < r.scene->steps_per_frame; ++s) {
             if (sem_world_step(r.world, &err) != SEM_OK) {
                 snprintf(failure, sizeof failure, "step %lld (t = %g): %s", r.steps + 1,
@@ -740,6 +741,7 @@ int cmd_run(int argc, char **argv)
             sem_contact_stats cs;
             sem_world_contact_stats(r.world, &cs);
             r.contact_sum += cs.seconds;
+            frame_gap = fmin(frame_gap, cs.min_gap);
             if (dt > r.step_max) r.step_max = dt;
             done_in_frame++;
             if (stop_signal) break;
@@ -760,6 +762,7 @@ int cmd_run(int argc, char **argv)
         }
         double stats[STAT_COUNT];
         frame_stats(&r, sem_world_time(r.world), stats);
+        stats[STAT_MIN_GAP] = frame_gap;
         if (sem_animation_add_frame(r.anim, f, frame_points(&r), &err) != SEM_OK ||
             save_state(&r, f, stats, &err) != SEM_OK) {
             snprintf(failure, sizeof failure, "frame %d: %s", f, err.message);

@@ -9,15 +9,41 @@
 #include "geometry/vector3.h"
 #include "narrow_phase.h"
 
+int sem_ccd_degenerate(const double a[3], const double b[3], const double c[3])
+{
+    double e[3][3], n[3], longest = 0;
+    for (int k = 0; k < 3; ++k) {
+        e[0][k] = b[k] - a[k];
+        e[1][k] = c[k] - b[k];
+        e[2][k] = a[k] - c[k];
+    }
+    for (int i = 0; i < 3; ++i) longest = fmax(longest, dot3(e[i], e[i]));
+    n[0] = e[0][1] * e[2][2] - e[0][2] * e[2][1];
+    n[1] = e[0][2] * e[2][0] - e[0][0] * e[2][2];
+    n[2] = e[0][0] * e[2][1] - e[0][1] * e[2][0];
+    return !(dot3(n, n) > 1e-20 * longest * longest);
+}
+
+double sem_ccd_triangle_distance(const double p[3], const double a[3], const double b[3], const double c[3])
+{
+    if (sem_ccd_degenerate(a, b, c)) {
+        const double *v[4] = {a, b, c, a};
+        double best = INFINITY, s, t;
+        for (int i = 0; i < 3; ++i) best = fmin(best, sem_segment_closest(p, p, v[i], v[i + 1], &s, &t));
+        return sqrt(best);
+    }
+    sem_tri_closest cl;
+    sem_point_triangle_closest(p, a, b, c, &cl);
+    return sqrt(cl.dist2);
+}
+
 static double distance(int edges, const double y[4][3])
 {
     if (edges) {
         double s, t;
         return sqrt(sem_segment_closest(y[0], y[1], y[2], y[3], &s, &t));
     }
-    sem_tri_closest c;
-    sem_point_triangle_closest(y[0], y[1], y[2], y[3], &c);
-    return sqrt(c.dist2);
+    return sem_ccd_triangle_distance(y[0], y[1], y[2], y[3]);
 }
 
 static double additive(int edges, const double *const x[4], const double *const p[4], double t_max)

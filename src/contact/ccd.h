@@ -20,6 +20,12 @@
 #define SEM_CCD_SEPARATION 0.1
 #define SEM_CCD_MAX_ADVANCES 20000
 
+/* The distance of p to triangle (a, b, c); a degenerate one (a sliver whose area is below
+ * 1e-10 of its longest edge squared: a pole of a sphere opening up) as its three edges. */
+double sem_ccd_triangle_distance(const double p[3], const double a[3], const double b[3], const double c[3]);
+/* Is triangle (a, b, c) degenerate in that sense? */
+int sem_ccd_degenerate(const double a[3], const double b[3], const double c[3]);
+
 /* Point x[0] against triangle x[1], x[2], x[3], moving by p[0..3] per unit t. */
 double sem_ccd_point_triangle(const double *const x[4], const double *const p[4], double t_max);
 /* Edge x[0]-x[1] against edge x[2]-x[3]. */

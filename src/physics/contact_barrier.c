@@ -115,17 +115,29 @@ typedef struct query {
 static void visit_point(int t, void *context)
 {
     const query *q = context;
-    if (q->mesh && sem_contact_collapsed(q->mesh, t)) return;
     const int *tri = q->items + 3 * (size_t)t;
+    const double *x[3] = {q->x + 3 * (size_t)tri[0], q->x + 3 * (size_t)tri[1], q->x + 3 * (size_t)tri[2]};
     sem_tri_closest cl;
-    sem_point_triangle_closest(q->a0, q->x + 3 * (size_t)tri[0], q->x + 3 * (size_t)tri[1], q->x + 3 * (size_t)tri[2],
-                               &cl);
+    if (sem_ccd_degenerate(x[0], x[1], x[2])) {
+        /* a sliver (a pole's fan at rest, opening as its corners' control points part): the
+         * distance to its nearest edge, so that the energy stays continuous as it opens */
+        cl.dist2 = INFINITY;
+        for (int e = 0; e < 3; ++e) {
+            double s, u, d2 = sem_segment_closest(q->a0, q->a0, x[e], x[(e + 1) % 3], &s, &u);
+            if (!(d2 < cl.dist2)) continue;
+            cl.dist2 = d2;
+            cl.bary[e] = 1 - u;
+            cl.bary[(e + 1) % 3] = u;
+            cl.bary[(e + 2) % 3] = 0;
+            for (int k = 0; k < 3; ++k) cl.point[k] = x[e][k] + u * (x[(e + 1) % 3][k] - x[e][k]);
+        }
+    } else
+        sem_point_triangle_closest(q->a0, x[0], x[1], x[2], &cl);
     if (!(cl.dist2 < q->reach2)) return;
     if (q->rest0) {
         const double *r = q->mesh->x0;
-        sem_tri_closest rc;
-        sem_point_triangle_closest(q->rest0, r + 3 * (size_t)tri[0], r + 3 * (size_t)tri[1], r + 3 * (size_t)tri[2], &rc);
-        if (!(rc.dist2 >= q->radius2)) return;
+        double d = sem_ccd_triangle_distance(q->rest0, r + 3 * (size_t)tri[0], r + 3 * (size_t)tri[1], r + 3 * (size_t)tri[2]);
+        if (!(d * d >= q->radius2)) return;
     }
     barrier_pair p;
     memset(&p, 0, sizeof p);
@@ -526,7 +538,7 @@ typedef struct sweep {
     const double *x0[2], *x1[2]; /* the primitive's vertices at both ends */
     const double *tx0, *tx1;    /* the tree's vertices at both ends (tx1 NULL: static) */
     const int *items;           /* the tree's triangles or edge triangles */
-    const sem_collision_mesh *mesh; /* the tree's mesh (NULL: a collider): collapsed triangles */
+    const sem_collision_mesh *mesh; /* the tree's mesh (NULL: a collider): its rest positions */
     const double *rest[2];      /* self pairs: the primitive at rest, and the rule's radius */
     double radius2;
     int skip_below;             /* edges: those with index <= this are left out; -1 */
@@ -538,7 +550,6 @@ static void visit_sweep(int item, void *context)
     sweep *w = context;
     if (w->edges && item <= w->skip_below) return;
     const int *v = w->items + 3 * (size_t)item;
-    if (!w->edges && w->mesh && sem_contact_collapsed(w->mesh, item)) return;
     if (w->rest[0]) {
         const double *r = w->mesh->x0;
         if (w->edges) {
@@ -547,9 +558,8 @@ static void visit_sweep(int item, void *context)
                   w->radius2))
                 return;
         } else {
-            sem_tri_closest cl;
-            sem_point_triangle_closest(w->rest[0], r + 3 * (size_t)v[0], r + 3 * (size_t)v[1], r + 3 * (size_t)v[2], &cl);
-            if (!(cl.dist2 >= w->radius2)) return;
+            double d = sem_ccd_triangle_distance(w->rest[0], r + 3 * (size_t)v[0], r + 3 * (size_t)v[1], r + 3 * (size_t)v[2]);
+            if (!(d * d >= w->radius2)) return;
         }
     }
     double p[4][3], zero[3] = {0, 0, 0};
@@ -612,7 +622,7 @@ static double point_step(const sem_contact *c, const sem_system *s, int k, int p
         sem_bvh_overlap(&col->bvh, lo, hi, visit_sweep, &w);
     }
     for (int j = 0; j < s->n_objects; ++j) {
-        if (j == k && !sem_contact_self_on(c)) continue;
+        if (j == k && (!sem_contact_self_on(c) || co->sweep_far)) continue;
         const contact_object *cj = &c->objects[c->sys_to_contact[j]];
         w.tx0 = cj->mesh.x;
         w.tx1 = cj->x1;
@@ -652,7 +662,7 @@ static double edge_step(const sem_contact *c, const sem_system *s, int k, int e,
     }
     for (int j = k; j < s->n_objects; ++j) {
         int self = j == k;
-        if (self && !sem_contact_self_on(c)) continue;
+        if (self && (!sem_contact_self_on(c) || co->sweep_far)) continue;
         const contact_object *cj = &c->objects[c->sys_to_contact[j]];
         w.tx0 = cj->mesh.x;
         w.tx1 = cj->x1;
@@ -668,11 +678,31 @@ static double edge_step(const sem_contact *c, const sem_system *s, int k, int e,
     return w.t;
 }
 
+/* Can no point of the object meet its own surface beyond the exclusion rule on the way from
+ * x to x1? Yes when at both ends it is near a rigid motion of its rest shape (self_far_apart:
+ * x = c + R r + e, |e| < 0.495 radius, radius the search radius) and the two rotations differ
+ * by less than 90 degrees: on the way x(t) = c(t) + ((1 - t) R0 + t R1) r + e(t), where
+ * (1 - t) I + t R0^T R1 shrinks no vector below cos(45 deg) = 0.71 of its length and |e(t)| <
+ * 0.495 radius, so points (and triangles) at least 2 radii apart at rest stay more than
+ * 2 (0.71 - 0.495) radius apart. A falling or tumbling object then skips the self part of
+ * the check. */
+static int sweep_far_apart(const contact_object *co)
+{
+    double R0[9], R1[9], radius = co->thickness + SEARCH_DEPTH * co->length;
+    if (!sem_contact_self_far_apart_at(&co->mesh, co->mesh.x, radius, R0) ||
+        !sem_contact_self_far_apart_at(&co->mesh, co->x1, radius, R1))
+        return 0;
+    double trace = 0; /* tr(R0^T R1) = 1 + 2 cos(angle) */
+    for (int i = 0; i < 9; ++i) trace += R0[i] * R1[i];
+    return trace >= 1.0;
+}
+
 sem_status sem_contact_max_step(sem_contact *c, const sem_system *s, const double *q, const double *dq, double scale,
                                 double *t_out, sem_error *err)
 {
     *t_out = 1;
     if (!sem_contact_barrier(c)) return SEM_OK;
+    double t0 = omp_get_wtime();
     sem_status st = sem_contact_map_system(c, s, err);
     if (st != SEM_OK) return st;
     double *q1 = malloc(s->n_dofs * sizeof(double) + 1);
@@ -688,6 +718,7 @@ sem_status sem_contact_max_step(sem_contact *c, const sem_system *s, const doubl
         sem_collision_mesh_positions(m, q1 + s->dof_offset[k], co->x1);
         sem_bvh_refit_swept(&m->bvh, m->x, co->x1, m->triangles);
         sem_bvh_refit_swept(&m->edge_bvh, m->x, co->x1, m->edge_tri);
+        co->sweep_far = sem_contact_self_on(c) && sweep_far_apart(co);
     }
     free(q1);
     if (st != SEM_OK) return st;
@@ -728,5 +759,6 @@ sem_status sem_contact_max_step(sem_contact *c, const sem_system *s, const doubl
         }
     }
     *t_out = t;
+    c->stats.seconds += omp_get_wtime() - t0;
     return SEM_OK;
 }

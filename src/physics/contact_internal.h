@@ -47,6 +47,7 @@ typedef struct contact_object {
     int self_far;            /* at the last detection no point can reach its own surface
                               * beyond the exclusion rule (self_far_apart): no self query */
     double *x1;              /* the barrier's collision check: the points at the step's end */
+    int sweep_far;           /* ... and no point can meet its own surface on the way */
 } contact_object;
 
 /* An active contact: point `point` of system object k against a collider or a triangle of
@@ -130,6 +131,9 @@ int sem_contact_collapsed(const sem_collision_mesh *m, int t);
 /* Is the mesh so near a rigid motion of its rest shape that no point can be within the
  * radius of a triangle the self-contact exclusion rule leaves it? */
 int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius);
+/* The same at positions x (3 per point); with rotation (may be NULL) the rotation it fitted
+ * (row-major), set whenever the test got that far. */
+int sem_contact_self_far_apart_at(const sem_collision_mesh *m, const double *x, double radius, double rotation[9]);
 /* grad += sum_i w_i f over the weights' dofs */
 void sem_contact_add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad);
 /* X = sum_i w_i q_i */

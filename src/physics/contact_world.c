@@ -294,12 +294,17 @@ static double det3(const double *a)
  * point. 0 when the test cannot tell (a flat or degenerate mesh): the queries run. */
 int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius)
 {
+    return sem_contact_self_far_apart_at(m, m->x, radius, NULL);
+}
+
+int sem_contact_self_far_apart_at(const sem_collision_mesh *m, const double *xs, double radius, double rotation[9])
+{
     int n = m->n_points;
     if (n <= 0) return 1;
     double c[3] = {0, 0, 0}, c0[3] = {0, 0, 0}, A[9] = {0};
     for (int p = 0; p < n; ++p)
         for (int a = 0; a < 3; ++a) {
-            c[a] += m->x[3 * (size_t)p + a];
+            c[a] += xs[3 * (size_t)p + a];
             c0[a] += m->x0[3 * (size_t)p + a];
         }
     for (int a = 0; a < 3; ++a) {
@@ -309,7 +314,7 @@ int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius)
     for (int p = 0; p < n; ++p)
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
-                A[3 * a + b] += (m->x[3 * (size_t)p + a] - c[a]) * (m->x0[3 * (size_t)p + b] - c0[b]);
+                A[3 * a + b] += (xs[3 * (size_t)p + a] - c[a]) * (m->x0[3 * (size_t)p + b] - c0[b]);
     double scale = 0;
     for (int i = 0; i < 9; ++i) scale += A[i] * A[i];
     scale = sqrt(scale / 3);
@@ -342,8 +347,9 @@ int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius)
         for (int k = 0; k < 3; ++k) row[k] /= l;
     }
     double limit = 0.99 * 0.5 * (SELF_EXCLUSION - 1) * radius, limit2 = limit * limit;
+    if (rotation) memcpy(rotation, A, sizeof A);
     for (int p = 0; p < n; ++p) {
-        const double *x = m->x + 3 * (size_t)p, *x0 = m->x0 + 3 * (size_t)p;
+        const double *x = xs + 3 * (size_t)p, *x0 = m->x0 + 3 * (size_t)p;
         double r0[3] = {x0[0] - c0[0], x0[1] - c0[1], x0[2] - c0[2]}, e[3];
         for (int a = 0; a < 3; ++a) e[a] = x[a] - c[a] - dot3(A + 3 * a, r0);
         if (!(dot3(e, e) < limit2)) return 0;
@@ -890,6 +896,49 @@ done:
     return st;
 }
 
+sem_status sem_contact_check_islands(sem_contact *c, sem_object *const *objects, int n, sem_error *err)
+{
+    if (!sem_contact_barrier(c) || n < 2) return SEM_OK;
+    double *box = malloc(6 * (size_t)n * sizeof(double) + 1);
+    if (!box) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
+    sem_status st = SEM_OK;
+    for (int i = 0; i < n && st == SEM_OK; ++i) {
+        int ci = -1;
+        for (int k = 0; k < c->n_objects && ci < 0; ++k)
+            if (c->objects[k].object == objects[i]) ci = k;
+        st = ci < 0 ? sem_error_set(err, SEM_ERR_INVALID, "contact: an object is not in the world")
+                    : sem_contact_mesh_for(c, ci, err);
+        if (st != SEM_OK) break;
+        contact_object *co = &c->objects[ci];
+        sem_collision_mesh_update(&co->mesh, objects[i]->q, 0);
+        double *b = box + 6 * (size_t)i;
+        for (int k = 0; k < 3; ++k) {
+            b[k] = INFINITY;
+            b[3 + k] = -INFINITY;
+        }
+        for (int p = 0; p < co->mesh.n_points; ++p)
+            for (int k = 0; k < 3; ++k) {
+                b[k] = fmin(b[k], co->mesh.x[3 * (size_t)p + k] - co->thickness);
+                b[3 + k] = fmax(b[3 + k], co->mesh.x[3 * (size_t)p + k] + co->thickness);
+            }
+    }
+    for (int i = 0; i < n && st == SEM_OK; ++i)
+        for (int j = i + 1; j < n && st == SEM_OK; ++j) {
+            if (objects[i]->system == objects[j]->system) continue;
+            const double *a = box + 6 * (size_t)i, *b = box + 6 * (size_t)j;
+            int overlap = 1;
+            for (int k = 0; k < 3; ++k) overlap &= a[k] <= b[3 + k] && b[k] <= a[3 + k];
+            if (overlap)
+                st = sem_error_set(err, SEM_ERR_NUMERIC,
+                                   "contact (barrier): objects %d and %d, solved apart in this step (they were far "
+                                   "apart at its start), came within reach of each other, unchecked; a smaller "
+                                   "integrator.dt keeps them in one solve",
+                                   i, j);
+        }
+    free(box);
+    return st;
+}
+
 void sem_contact_begin_world_step(sem_contact *c)
 {
     c->stats.seconds = 0;
@@ -930,7 +979,10 @@ sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n
             }
             speed2 = fmax(speed2, dot3(v, v));
         }
-        double grow = 3 * (co->thickness + SEARCH_DEPTH * co->length) + fabs(h) * sqrt(speed2);
+        /* the barrier: twice the predicted move, so that an object thrown back within the
+         * step (a bounce) stays in its island (sem_contact_check_islands checks it) */
+        double grow = 3 * (co->thickness + SEARCH_DEPTH * co->length) +
+                      (def_is_barrier(c) ? 2 : 1) * fabs(h) * sqrt(speed2);
         for (int k = 0; k < 3; ++k) {
             b[k] -= grow;
             b[3 + k] += grow;

@@ -57,6 +57,10 @@ int sem_contact_active(const sem_contact *c);
  * control point's speed, overlap. Objects of different islands are solved apart. */
 sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n, double h, int *island,
                                sem_error *err);
+/* The barrier model, after a step solved in several systems: an error if objects of
+ * different systems ended within reach of each other (their crossing would have gone
+ * unchecked; the islands are grown by twice the predicted move so that it does not happen). */
+sem_status sem_contact_check_islands(sem_contact *c, sem_object *const *objects, int n, sem_error *err);
 /* Starts a world step: the statistics (contacts, min_gap, seconds) sum over its systems. */
 void sem_contact_begin_world_step(sem_contact *c);
 /* Also makes the system again (solver: its choice) when objects came near each other and

@@ -324,6 +324,10 @@ sem_status sem_world_step(sem_world *w, sem_error *err)
         if (st == SEM_OK) st = sem_contact_end_step(w->contact, s, err);
         if (st != SEM_OK) return st;
     }
+    if (w->n_systems > 1) {
+        sem_status st = sem_contact_check_islands(w->contact, w->objects, w->n_objects, err);
+        if (st != SEM_OK) return st;
+    }
     for (int k = 0; k < w->n_objects; ++k) {
         sem_status st = sem_runaway_check(w->objects[k], w->def.integrator == SEM_STATIC, t1, err);
         if (st != SEM_OK) return st;
