@@ -430,7 +430,8 @@ static void test_examples(const char *tmp)
 {
     static const char *const examples[] = {"default_beam",  "twisting_beam", "bouncing_sphere",
                                            "patch_test",    "two_materials", "wind_castle",
-                                           "box_drop",      "incline",       "spheres_collide", NULL};
+                                           "box_drop",      "incline",       "spheres_collide", "torus_chain",
+                                           NULL};
     for (int k = 0; examples[k]; ++k) {
         /* under sanitizers: one frame, and the slow implicit default scene only once above */
         if (g_sanitized && !strcmp(examples[k], "default_beam")) continue;
