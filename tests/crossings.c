@@ -6,6 +6,9 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "contact/narrow_phase.h"
+#include "geometry/point_triangle.h"
+
 typedef struct box {
     double lo[3], hi[3];
     int t;
@@ -79,7 +82,36 @@ static int touch_at_rest(const double *x0, const int *s, const int *t, double to
     return 0;
 }
 
+/* The distance between triangles s and t at x (the least of their vertex-triangle and
+ * edge-edge distances). */
+static double triangle_distance(const double *x, const int *s, const int *t)
+{
+    double best = INFINITY;
+    for (int side = 0; side < 2; ++side) {
+        const int *a = side ? t : s, *b = side ? s : t;
+        for (int i = 0; i < 3; ++i) {
+            sem_tri_closest c;
+            sem_point_triangle_closest(x + 3 * (size_t)a[i], x + 3 * (size_t)b[0], x + 3 * (size_t)b[1],
+                                       x + 3 * (size_t)b[2], &c);
+            best = fmin(best, c.dist2);
+        }
+    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double u, v;
+            best = fmin(best, sem_segment_closest(x + 3 * (size_t)s[i], x + 3 * (size_t)s[(i + 1) % 3],
+                                                  x + 3 * (size_t)t[j], x + 3 * (size_t)t[(j + 1) % 3], &u, &v));
+        }
+    return sqrt(best);
+}
+
 long count_crossings(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles)
+{
+    return count_crossings_apart(x0, x, n_vertices, triangles, n_triangles, 0);
+}
+
+long count_crossings_apart(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles,
+                           double apart)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int v = 0; v < n_vertices; ++v)
@@ -114,7 +146,9 @@ long count_crossings(const double *x0, const double *x, int n_vertices, const in
                 continue;
             const int *s = triangles + 3 * (size_t)b[i].t, *t = triangles + 3 * (size_t)b[j].t;
             if (touch_at_rest(x0, s, t, tol2)) continue;
-            if (triangles_cross(x, s, t)) ++count;
+            if (triangles_cross(x, s, t) && !triangles_cross(x0, s, t) &&
+                !(apart > 0 && triangle_distance(x0, s, t) < apart))
+                ++count;
         }
     free(b);
     return count;

@@ -13,7 +13,12 @@
 #define SEM_TESTS_CROSSINGS_H
 
 /* Counts the intersecting pairs of the mesh at positions x (3 per vertex) that do not touch
- * at rest positions x0; triangles: 3 vertex indices each. -1: out of memory. */
+ * or cross at rest positions x0; triangles: 3 vertex indices each. -1: out of memory. */
 long count_crossings(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles);
+/* The same among pairs at least `apart` from each other at rest (self-contact's exclusion
+ * rule: parts of one object near each other at rest, such as a limb overlapping a body, are
+ * not kept apart). */
+long count_crossings_apart(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles,
+                           double apart);
 
 #endif
