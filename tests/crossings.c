@@ -4,10 +4,13 @@
 #include "crossings.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "contact/narrow_phase.h"
 #include "geometry/point_triangle.h"
+#include "io/mesh_obj_read.h"
 
 typedef struct box {
     double lo[3], hi[3];
@@ -152,4 +155,139 @@ long count_crossings_apart(const double *x0, const double *x, int n_vertices, co
         }
     free(b);
     return count;
+}
+
+/* ---- a run's frames ---- */
+
+/* The part (an OBJ group, numbered across the objects from first) of each of the file's
+ * vertices, into part (at most n_max); their count in *n_read; returns the next part number,
+ * -1 when unreadable. sem's render meshes write each part's group line, then its vertices
+ * and faces. */
+static int vertex_parts(const char *path, int first, int *part, int n_max, int *n_read)
+{
+    FILE *f = fopen(path, "r");
+    *n_read = 0;
+    if (!f) return -1;
+    char line[512];
+    int current = first - 1, n = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == 'g' && line[1] == ' ') current++;
+        if (line[0] == 'v' && line[1] == ' ' && n < n_max) part[n++] = current < first ? first : current;
+    }
+    fclose(f);
+    *n_read = n;
+    return current + 1;
+}
+
+/* frame k's mesh of object o of n_objects (sem run's names) */
+static void frame_path(const char *dir, int k, int o, int n_objects, char *path, size_t size)
+{
+    if (n_objects == 1)
+        snprintf(path, size, "%s/frame_%04d_mesh.obj", dir, k);
+    else
+        snprintf(path, size, "%s/frame_%04d_object%d_mesh.obj", dir, k, o);
+}
+
+/* Frame k's meshes of all objects as one soup (objects' vertices one after the other). */
+static int read_frame(const char *dir, int k, int n_objects, sem_triangle_soup *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int o = 0; o < n_objects; ++o) {
+        char path[1200];
+        frame_path(dir, k, o, n_objects, path, sizeof path);
+        sem_triangle_soup part;
+        sem_error err;
+        if (sem_obj_triangles_read(path, &part, NULL, &err) != SEM_OK) {
+            sem_triangle_soup_free(out);
+            return -1;
+        }
+        double *v = realloc(out->vertices, 3 * (size_t)(out->n_vertices + part.n_vertices) * sizeof(double));
+        int *t = realloc(out->triangles, 3 * (size_t)(out->n_triangles + part.n_triangles) * sizeof(int));
+        if (v) out->vertices = v;
+        if (t) out->triangles = t;
+        if (!v || !t) {
+            sem_triangle_soup_free(&part);
+            sem_triangle_soup_free(out);
+            return -1;
+        }
+        memcpy(out->vertices + 3 * (size_t)out->n_vertices, part.vertices, 3 * (size_t)part.n_vertices * sizeof(double));
+        for (int i = 0; i < 3 * part.n_triangles; ++i)
+            out->triangles[3 * (size_t)out->n_triangles + (size_t)i] = part.triangles[i] + out->n_vertices;
+        out->n_vertices += part.n_vertices;
+        out->n_triangles += part.n_triangles;
+        sem_triangle_soup_free(&part);
+    }
+    return 0;
+}
+
+long run_crossings(const char *dir, int frames, int n_objects, double apart, int *worst)
+{
+    sem_triangle_soup rest, frame;
+    if (read_frame(dir, 0, n_objects, &rest) != 0) return -1;
+    int n = rest.n_vertices, *part = malloc(((size_t)n + 1) * sizeof(int)), *rep = malloc(((size_t)n + 1) * sizeof(int));
+    int *count = calloc((size_t)n + 1, sizeof(int));
+    double *sum = malloc(3 * ((size_t)n + 1) * sizeof(double));
+    if (!part || !rep || !count || !sum) {
+        free(part), free(rep), free(count), free(sum);
+        sem_triangle_soup_free(&rest);
+        return -1;
+    }
+    for (int o = 0, next = 0, offset = 0; o < n_objects; ++o) {
+        char path[1200];
+        int nv;
+        frame_path(dir, 0, o, n_objects, path, sizeof path);
+        next = vertex_parts(path, next, part + offset, n - offset, &nv);
+        offset += nv;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int v = 0; v < n; ++v)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = fmin(lo[c], rest.vertices[3 * (size_t)v + c]);
+            hi[c] = fmax(hi[c], rest.vertices[3 * (size_t)v + c]);
+        }
+    double tol = 1e-9 * sqrt(pow(hi[0] - lo[0], 2) + pow(hi[1] - lo[1], 2) + pow(hi[2] - lo[2], 2));
+    for (int v = 0; v < n; ++v) {
+        rep[v] = v;
+        for (int u = 0; u < v && rep[v] == v; ++u) {
+            if (part[u] != part[v] || rep[u] != u) continue;
+            double d2 = 0;
+            for (int c = 0; c < 3; ++c) d2 += pow(rest.vertices[3 * (size_t)u + c] - rest.vertices[3 * (size_t)v + c], 2);
+            if (d2 <= tol * tol) rep[v] = u;
+        }
+    }
+    long total = 0, most = 0;
+    *worst = -1;
+    for (int k = 0; k <= frames; ++k) {
+        if (read_frame(dir, k, n_objects, &frame) != 0) {
+            total = -1;
+            break;
+        }
+        if (frame.n_vertices == n) {
+            memset(count, 0, (size_t)n * sizeof(int));
+            memset(sum, 0, 3 * (size_t)n * sizeof(double));
+            for (int v = 0; v < n; ++v) {
+                count[rep[v]]++;
+                for (int c = 0; c < 3; ++c) sum[3 * (size_t)rep[v] + c] += frame.vertices[3 * (size_t)v + c];
+            }
+            for (int v = 0; v < n; ++v)
+                for (int c = 0; c < 3; ++c)
+                    frame.vertices[3 * (size_t)v + c] = sum[3 * (size_t)rep[v] + c] / count[rep[v]];
+        }
+        long c = frame.n_vertices == n ? count_crossings_apart(rest.vertices, frame.vertices, rest.n_vertices,
+                                                               rest.triangles, rest.n_triangles, apart)
+                                       : -1;
+        sem_triangle_soup_free(&frame);
+        if (c < 0) {
+            total = -1;
+            break;
+        }
+        if (c > most) {
+            most = c;
+            *worst = k;
+        }
+        total += c;
+    }
+    sem_triangle_soup_free(&rest);
+    free(part), free(rep), free(count), free(sum);
+    return total;
 }

@@ -7,7 +7,8 @@
  * parts, whose vertices the mesh repeats). Two triangles intersect when an edge of one
  * passes through the other (a proper crossing of non-coplanar triangles always has one;
  * coplanar touching is not counted). Sweep and prune along x over the triangles' boxes, so a
- * frame of a few thousand triangles takes milliseconds.
+ * frame of a few thousand triangles takes milliseconds. Also the same over a run's frames
+ * (the barrier's scenes, tests/test_barrier_scenes.c).
  */
 #ifndef SEM_TESTS_CROSSINGS_H
 #define SEM_TESTS_CROSSINGS_H
@@ -20,5 +21,15 @@ long count_crossings(const double *x0, const double *x, int n_vertices, const in
  * not kept apart). */
 long count_crossings_apart(const double *x0, const double *x, int n_vertices, const int *triangles, int n_triangles,
                            double apart);
+
+/* The crossing pairs over frames 0..frames of a `sem run` folder (its n_objects objects'
+ * frame meshes as one mesh; pairs touching or crossing in frame 0, or nearer than apart
+ * there, left out); the frame with the most in *worst; -1 when a frame is missing. The
+ * surfaces checked are the collision meshes when the run's output.mesh_resolution is its
+ * contact.resolution: the frames' render meshes with the copies of a point on one part (a
+ * sphere's pole: a vertex per u, one point at rest) at their mean, as the collision mesh
+ * keeps them (src/contact/collision_mesh.h; the NURBS itself may open up there as its
+ * collapsed control points part). */
+long run_crossings(const char *dir, int frames, int n_objects, double apart, int *worst);
 
 #endif

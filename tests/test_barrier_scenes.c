@@ -81,162 +81,11 @@ static cJSON *with_contact(cJSON *scene, const char *model, int frames)
     return scene;
 }
 
-/* The part (an OBJ group, numbered across the objects from first) of each of the file's
- * vertices, into part + offset; returns the next part number, -1 when unreadable. The
- * render mesh writes each part's group line, then its vertices and faces. */
-static int vertex_parts(const char *path, int first, int *part, int n_max)
-{
-    FILE *f = fopen(path, "r");
-    if (!f) return -1;
-    char line[512];
-    int current = first - 1, n = 0;
-    while (fgets(line, sizeof line, f)) {
-        if (line[0] == 'g' && line[1] == ' ') current++;
-        if (line[0] == 'v' && line[1] == ' ' && n < n_max) part[n++] = current < first ? first : current;
-    }
-    fclose(f);
-    return current + 1;
-}
-
-/* Frame k's meshes of all objects as one soup (objects' vertices one after the other). */
-static int read_frame(const char *dir, int k, int n_objects, sem_triangle_soup *out)
-{
-    memset(out, 0, sizeof *out);
-    for (int o = 0; o < n_objects; ++o) {
-        char path[1200];
-        if (n_objects == 1)
-            snprintf(path, sizeof path, "%s/frame_%04d_mesh.obj", dir, k);
-        else
-            snprintf(path, sizeof path, "%s/frame_%04d_object%d_mesh.obj", dir, k, o);
-        sem_triangle_soup part;
-        sem_error err;
-        if (sem_obj_triangles_read(path, &part, NULL, &err) != SEM_OK) {
-            sem_triangle_soup_free(out);
-            return -1;
-        }
-        double *v = realloc(out->vertices, 3 * (size_t)(out->n_vertices + part.n_vertices) * sizeof(double));
-        int *t = realloc(out->triangles, 3 * (size_t)(out->n_triangles + part.n_triangles) * sizeof(int));
-        if (v) out->vertices = v;
-        if (t) out->triangles = t;
-        if (!v || !t) {
-            sem_triangle_soup_free(&part);
-            sem_triangle_soup_free(out);
-            return -1;
-        }
-        memcpy(out->vertices + 3 * (size_t)out->n_vertices, part.vertices, 3 * (size_t)part.n_vertices * sizeof(double));
-        for (int i = 0; i < 3 * part.n_triangles; ++i)
-            out->triangles[3 * (size_t)out->n_triangles + (size_t)i] = part.triangles[i] + out->n_vertices;
-        out->n_vertices += part.n_vertices;
-        out->n_triangles += part.n_triangles;
-        sem_triangle_soup_free(&part);
-    }
-    return 0;
-}
-
-/* The crossing triangle pairs of every frame 0..frames (pairs that touch in frame 0 left
- * out); the frame with the most in *worst; -1 when a frame is missing. The surfaces checked
- * are the collision meshes: the frames' render meshes (tessellated at the same resolution)
- * with the copies of a point on one part (a sphere's pole: a vertex per u, one point at
- * rest) at the mean of the copies, as the collision mesh keeps them (collision_mesh.h; the
- * NURBS itself may open up there as its collapsed control points part). */
-static long run_crossings_apart(const char *dir, int frames, int n_objects, double apart, int *worst)
-{
-    sem_triangle_soup rest, frame;
-    if (read_frame(dir, 0, n_objects, &rest) != 0) return -1;
-    int n = rest.n_vertices, *part = malloc(((size_t)n + 1) * sizeof(int)), *rep = malloc(((size_t)n + 1) * sizeof(int));
-    int *count = calloc((size_t)n + 1, sizeof(int));
-    double *sum = malloc(3 * ((size_t)n + 1) * sizeof(double));
-    if (!part || !rep || !count || !sum) {
-        free(part), free(rep), free(count), free(sum);
-        sem_triangle_soup_free(&rest);
-        return -1;
-    }
-    for (int o = 0, next = 0, offset = 0; o < n_objects; ++o) {
-        char path[1200];
-        if (n_objects == 1)
-            snprintf(path, sizeof path, "%s/frame_0000_mesh.obj", dir);
-        else
-            snprintf(path, sizeof path, "%s/frame_0000_object%d_mesh.obj", dir, o);
-        sem_triangle_soup one;
-        sem_error err;
-        int nv = sem_obj_triangles_read(path, &one, NULL, &err) == SEM_OK ? one.n_vertices : 0;
-        if (nv) sem_triangle_soup_free(&one);
-        next = vertex_parts(path, next, part + offset, n - offset);
-        offset += nv;
-    }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int v = 0; v < n; ++v)
-        for (int c = 0; c < 3; ++c) {
-            lo[c] = fmin(lo[c], rest.vertices[3 * (size_t)v + c]);
-            hi[c] = fmax(hi[c], rest.vertices[3 * (size_t)v + c]);
-        }
-    double tol = 1e-9 * sqrt(pow(hi[0] - lo[0], 2) + pow(hi[1] - lo[1], 2) + pow(hi[2] - lo[2], 2));
-    for (int v = 0; v < n; ++v) {
-        rep[v] = v;
-        for (int u = 0; u < v && rep[v] == v; ++u) {
-            if (part[u] != part[v] || rep[u] != u) continue;
-            double d2 = 0;
-            for (int c = 0; c < 3; ++c) d2 += pow(rest.vertices[3 * (size_t)u + c] - rest.vertices[3 * (size_t)v + c], 2);
-            if (d2 <= tol * tol) rep[v] = u;
-        }
-    }
-    long total = 0, most = 0;
-    *worst = -1;
-    for (int k = 0; k <= frames; ++k) {
-        if (read_frame(dir, k, n_objects, &frame) != 0) {
-            total = -1;
-            break;
-        }
-        if (frame.n_vertices == n) {
-            memset(count, 0, (size_t)n * sizeof(int));
-            memset(sum, 0, 3 * (size_t)n * sizeof(double));
-            for (int v = 0; v < n; ++v) {
-                count[rep[v]]++;
-                for (int c = 0; c < 3; ++c) sum[3 * (size_t)rep[v] + c] += frame.vertices[3 * (size_t)v + c];
-            }
-            for (int v = 0; v < n; ++v)
-                for (int c = 0; c < 3; ++c)
-                    frame.vertices[3 * (size_t)v + c] = sum[3 * (size_t)rep[v] + c] / count[rep[v]];
-        }
-        long c = frame.n_vertices == n ? count_crossings_apart(rest.vertices, frame.vertices, rest.n_vertices,
-                                                               rest.triangles, rest.n_triangles, apart)
-                                       : -1;
-        sem_triangle_soup_free(&frame);
-        if (c < 0) {
-            total = -1;
-            break;
-        }
-        if (c > most) {
-            most = c;
-            *worst = k;
-        }
-        total += c;
-    }
-    sem_triangle_soup_free(&rest);
-    free(part), free(rep), free(count), free(sum);
-    return total;
-}
-
 /* one line of text (a newline only at its end) */
 static int one_line(const char *text)
 {
     const char *nl = strchr(text, '\n');
     return text[0] && (!nl || !nl[1]);
-}
-
-static long run_crossings(const char *dir, int frames, int n_objects, int *worst)
-{
-    return run_crossings_apart(dir, frames, n_objects, 0, worst);
-}
-
-static cJSON *summary(const char *dir)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    char *text = test_slurp(path, NULL);
-    cJSON *s = text ? cJSON_Parse(text) : NULL;
-    free(text);
-    return s;
 }
 
 static const char *status_of(const cJSON *s)
@@ -298,24 +147,24 @@ static double object_height(const char *dir, int k, int o)
     return hi - lo;
 }
 
-/* Runs examples/NAME.json with the barrier for frames frames and checks that no frame
- * crosses and every gap is above zero; returns the summary (caller deletes) and the run's
- * folder in dir. */
-static cJSON *barrier_example(const char *name, int frames, int n_objects, double apart, const char *tmp, char *dir,
-                              size_t dir_size, frames_info *info)
+/* Runs scene (taken; with_contact(..., "barrier", frames)) as TAG and checks that it runs
+ * all its frames, that no frame crosses (pairs nearer than apart at rest left out) and every
+ * gap is above zero; returns the summary (caller deletes) and the run's folder in dir. */
+static cJSON *barrier_run(cJSON *scene, const char *tag, int frames, int n_objects, double apart, const char *tmp,
+                          char *dir, size_t dir_size, frames_info *info)
 {
     char se[1 << 14];
-    int rc = run(with_contact(example(name), "barrier", frames), name, tmp, dir, dir_size, se, sizeof se);
-    CHECK(rc == 0, "%s, barrier: exit %d: %s", name, rc, se);
+    int rc = run(scene, tag, tmp, dir, dir_size, se, sizeof se);
+    CHECK(rc == 0, "%s, barrier: exit %d: %s", tag, rc, se);
     int worst;
-    long crossings = run_crossings_apart(dir, frames, n_objects, apart, &worst);
-    cJSON *s = summary(dir);
+    long crossings = run_crossings(dir, frames, n_objects, apart, &worst);
+    cJSON *s = test_read_summary(dir);
     *info = scan(s);
-    printf("%s, barrier: status %s, %ld crossing pairs, smallest gap %.3g m, %d frames\n", name, status_of(s),
+    printf("%s, barrier: status %s, %ld crossing pairs, smallest gap %.3g m, %d frames\n", tag, status_of(s),
            crossings, info->min_gap, info->frames - 1);
-    CHECK(crossings == 0, "%s, barrier: %ld crossing pairs (most at frame %d)", name, crossings, worst);
-    CHECK(info->min_gap > 0, "%s, barrier: smallest gap %g", name, info->min_gap);
-    CHECK(info->frames == frames + 1, "%s, barrier: %d frames of %d", name, info->frames - 1, frames);
+    CHECK(crossings == 0, "%s, barrier: %ld crossing pairs (most at frame %d)", tag, crossings, worst);
+    CHECK(info->min_gap > 0, "%s, barrier: smallest gap %g", tag, info->min_gap);
+    CHECK(info->frames == frames + 1, "%s, barrier: %d frames of %d", tag, info->frames - 1, frames);
     return s;
 }
 
@@ -341,28 +190,24 @@ int main(void)
     snprintf(cache, sizeof cache, "%s/cache", tmp);
     setenv("SEM_CACHE_DIR", cache, 1);
     int sanitized = getenv("SEM_SANITIZED") != NULL;
-    int worst;
 
     /* the ball and the plate */
     int frames = sanitized ? 4 : 12;
-    int rc = run(with_contact(ball_and_plate(), "barrier", frames), "ball", tmp, dir, sizeof dir, se, sizeof se);
-    CHECK(rc == 0, "ball, barrier: exit %d: %s", rc, se);
-    long crossings = run_crossings(dir, frames, 2, &worst);
-    cJSON *s = summary(dir);
-    frames_info f = scan(s);
-    printf("ball on a plate at 10 m/s, barrier: status %s, %ld crossing pairs (most at frame %d), smallest gap %.3g "
-           "m, height %.3f m at frame %d\n",
-           status_of(s), crossings, worst, f.min_gap, f.last_height, frames);
-    CHECK(crossings == 0, "ball, barrier: %ld crossing pairs (most at frame %d)", crossings, worst);
-    CHECK(f.min_gap > 0 && f.min_gap < 0.01, "ball, barrier: smallest gap %g", f.min_gap);
+    frames_info f;
+    cJSON *s = barrier_run(with_contact(ball_and_plate(), "barrier", frames), "ball", frames, 2, 0, tmp, dir,
+                           sizeof dir, &f);
+    printf("ball on a plate at 10 m/s, barrier: height %.3f m at frame %d\n", f.last_height, frames);
+    CHECK(f.min_gap < 0.01, "ball, barrier: smallest gap %g", f.min_gap);
     CHECK(!strcmp(status_of(s), "ok"), "ball, barrier: status %s", status_of(s));
     /* it stopped on the plate (centre 0.105 m above it) and flew back */
     if (!sanitized) CHECK(f.last_height > 0.13, "ball, barrier: at %.3f m after the rebound", f.last_height);
     cJSON_Delete(s);
     if (!sanitized) {
-        rc = run(with_contact(ball_and_plate(), "penalty", frames), "ball_penalty", tmp, dir, sizeof dir, se, sizeof se);
-        long pc = rc == 0 ? run_crossings(dir, frames, 2, &worst) : -1;
-        s = summary(dir);
+        int worst;
+        int rc = run(with_contact(ball_and_plate(), "penalty", frames), "ball_penalty", tmp, dir, sizeof dir, se,
+                     sizeof se);
+        long pc = rc == 0 ? run_crossings(dir, frames, 2, 0, &worst) : -1;
+        s = test_read_summary(dir);
         f = scan(s);
         printf("the same with the penalty: exit %d, %ld crossing pairs, height %.3f m\n", rc, pc, f.last_height);
         CHECK(rc != 0 || pc > 0 || f.last_height < 0, "the penalty stops the shot too: the check above proves nothing");
@@ -371,16 +216,10 @@ int main(void)
 
     /* two spheres head-on */
     frames = sanitized ? 15 : 40;
-    rc = run(with_contact(example("spheres_collide"), "barrier", frames), "spheres", tmp, dir, sizeof dir, se,
-             sizeof se);
-    CHECK(rc == 0, "spheres, barrier: exit %d: %s", rc, se);
-    crossings = run_crossings(dir, frames, 2, &worst);
-    s = summary(dir);
-    f = scan(s);
-    printf("spheres head-on, barrier: status %s, %ld crossing pairs, smallest gap %.3g m, momentum changed by %.3g\n",
-           status_of(s), crossings, f.min_gap, f.max_momentum);
-    CHECK(crossings == 0, "spheres, barrier: %ld crossing pairs (most at frame %d)", crossings, worst);
-    CHECK(f.min_gap > 0 && f.min_gap < 0.01, "spheres, barrier: smallest gap %g (they never came near?)", f.min_gap);
+    s = barrier_run(with_contact(example("spheres_collide"), "barrier", frames), "spheres", frames, 2, 0, tmp, dir,
+                    sizeof dir, &f);
+    printf("spheres head-on, barrier: momentum changed by %.3g\n", f.max_momentum);
+    CHECK(f.min_gap < 0.01, "spheres, barrier: smallest gap %g (they never came near?)", f.min_gap);
     /* each 524 kg at 1 m/s: the total momentum does not change (to the Newton tolerance) */
     CHECK(f.max_momentum < 1e-6, "spheres, barrier: total momentum changed by %g", f.max_momentum);
     cJSON_Delete(s);
@@ -397,22 +236,16 @@ int main(void)
     /* the turned end comes down 2 mm above the lower half (the example's end lands flush on
      * it, at distance 0, which the barrier cannot let the pins do) */
     if (cJSON_GetArraySize(axis) == 3) cJSON_ReplaceItemInArray(axis, 2, cJSON_CreateNumber(0.102));
-    rc = run(fold, "fold", tmp, dir, sizeof dir, se, sizeof se);
-    CHECK(rc == 0, "beam_fold, barrier: exit %d: %s", rc, se);
-    crossings = run_crossings(dir, frames, 1, &worst);
-    s = summary(dir);
-    f = scan(s);
-    printf("beam_fold, barrier: status %s, %ld crossing pairs, smallest gap %.3g m, self contacts in %d frames\n",
-           status_of(s), crossings, f.min_gap, f.self_frames);
-    CHECK(crossings == 0, "beam_fold, barrier: %ld crossing pairs (most at frame %d)", crossings, worst);
-    CHECK(f.min_gap > 0, "beam_fold, barrier: smallest gap %g", f.min_gap);
+    s = barrier_run(fold, "fold", frames, 1, 0, tmp, dir, sizeof dir, &f);
+    printf("beam_fold, barrier: self contacts in %d frames\n", f.self_frames);
     CHECK(f.self_frames >= (sanitized ? 1 : 10), "beam_fold, barrier: self contacts in %d frames only", f.self_frames);
     cJSON_Delete(s);
 
     /* examples/torus_chain.json: the two free rings fall into the held one and hang from it
      * (the lowest ring 0.45 m below the top one's centre at rest, lower when it hangs) */
     frames = sanitized ? 10 : 40;
-    s = barrier_example("torus_chain", frames, 3, 0, tmp, dir, sizeof dir, &f);
+    s = barrier_run(with_contact(example("torus_chain"), "barrier", frames), "torus_chain", frames, 3, 0, tmp, dir,
+                    sizeof dir, &f);
     CHECK(f.min_gap < 0.01, "torus_chain: the rings never met (smallest gap %g)", f.min_gap);
     cJSON_Delete(s);
 
@@ -420,7 +253,8 @@ int main(void)
      * height (0.5 m at rest, the plates 0.255 m apart at the end) */
     if (!sanitized) {
         frames = 50;
-        s = barrier_example("sphere_squeeze", frames, 3, 0, tmp, dir, sizeof dir, &f);
+        s = barrier_run(with_contact(example("sphere_squeeze"), "barrier", frames), "sphere_squeeze", frames, 3, 0,
+                        tmp, dir, sizeof dir, &f);
         double h0 = object_height(dir, 0, 0), h1 = object_height(dir, frames, 0);
         printf("sphere_squeeze, barrier: height %.4f m at rest, %.4f m squeezed\n", h0, h1);
         CHECK(h1 < 0.55 * h0 && h1 > 0.45 * h0, "sphere_squeeze: height %g of %g", h1, h0);
@@ -434,7 +268,8 @@ int main(void)
         frames = 40;
         /* its limbs overlap its body at rest: pairs within the exclusion rule's 2 search
          * radii at rest (2 (1e-3 + 0.05) L, L = 1.94 m its control net's diagonal) are not kept apart */
-        s = barrier_example("octopus_drop", frames, 1, 2 * (1e-3 + 0.05) * 1.94, tmp, dir, sizeof dir, &f);
+        s = barrier_run(with_contact(example("octopus_drop"), "barrier", frames), "octopus_drop", frames, 1,
+                        2 * (1e-3 + 0.05) * 1.94, tmp, dir, sizeof dir, &f);
         CHECK(f.min_gap < 0.01, "octopus_drop: it never touched the ground (smallest gap %g)", f.min_gap);
         cJSON_Delete(s);
     }
@@ -444,7 +279,7 @@ int main(void)
         cJSON *scene = with_contact(ball_and_plate(), "barrier", 2);
         cJSON_ReplaceItemInObjectCaseSensitive(scene, "integrator",
                                                cJSON_Parse("{\"type\": \"linearly_implicit_euler\", \"dt\": 0.01}"));
-        rc = run(scene, "linear", tmp, dir, sizeof dir, se, sizeof se);
+        int rc = run(scene, "linear", tmp, dir, sizeof dir, se, sizeof se);
         CHECK(rc != 0 && strstr(se, "barrier") && strstr(se, "implicit_euler") && one_line(se),
               "barrier with the linearly implicit step: exit %d, '%s'", rc, se);
         scene = with_contact(ball_and_plate(), "barrier", 2);

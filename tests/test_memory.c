@@ -32,16 +32,6 @@ static double num(const cJSON *o, const char *key)
     return cJSON_IsNumber(x) ? x->valuedouble : NAN;
 }
 
-static cJSON *read_summary(const char *dir)
-{
-    char p[1024];
-    snprintf(p, sizeof p, "%s/summary.json", dir);
-    char *t = test_slurp(p, NULL);
-    cJSON *j = t ? cJSON_Parse(t) : NULL;
-    free(t);
-    return j;
-}
-
 static sem_discretization *preprocess(sem_model *m)
 {
     sem_error err;
@@ -139,7 +129,7 @@ static void test_warning(void)
     rc = test_run_cli(args, out_buf, sizeof out_buf, err_buf, sizeof err_buf);
     CHECK(rc == 0, "run: exit %d: %s", rc, err_buf);
     CHECK(strstr(err_buf, "this run needs about") == NULL, "a box on this machine warns: %s", err_buf);
-    cJSON *s = read_summary(out);
+    cJSON *s = test_read_summary(out);
     CHECK(s != NULL, "no summary.json in %s", out);
     if (s) {
         double peak = num(s, "peak_memory_bytes"), est = num(s, "estimated_memory_bytes");
@@ -164,7 +154,7 @@ static void test_estimate_vs_peak(void)
     snprintf(args, sizeof args, "run '%s' --overwrite --no-cache --quiet", scene);
     int rc = test_run_cli(args, out_buf, sizeof out_buf, err_buf, sizeof err_buf);
     CHECK(rc == 0, "mug run: exit %d: %s", rc, err_buf);
-    cJSON *s = read_summary(out);
+    cJSON *s = test_read_summary(out);
     CHECK(s != NULL, "no summary.json in %s", out);
     if (!s) return;
     double peak = num(s, "peak_memory_bytes"), est = num(s, "estimated_memory_bytes");

@@ -82,10 +82,7 @@ static void run_case(const scene_case *c, const char *tmp)
     snprintf(args, sizeof args, "run %s --out %s --quiet", path, dir);
     int rc = test_run_cli(args, so, sizeof so, se, sizeof se);
     CHECK(rc == 0, "%s: exit %d: %s", c->name, rc, se);
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    text = test_slurp(path, NULL);
-    cJSON *s = text ? cJSON_Parse(text) : NULL;
-    free(text);
+    cJSON *s = test_read_summary(dir);
     CHECK(s != NULL, "%s: no summary.json", c->name);
     if (!s) return;
     const cJSON *status = cJSON_GetObjectItemCaseSensitive(s, "status");

@@ -25,16 +25,6 @@ static int exists(const char *dir, const char *name)
 }
 
 
-static cJSON *read_summary(const char *dir)
-{
-    char p[1024];
-    snprintf(p, sizeof p, "%s/summary.json", dir);
-    char *t = test_slurp(p, NULL);
-    cJSON *j = t ? cJSON_Parse(t) : NULL;
-    free(t);
-    return j;
-}
-
 static double num(const cJSON *o, const char *key)
 {
     const cJSON *x = cJSON_GetObjectItemCaseSensitive(o, key);
@@ -127,7 +117,7 @@ static void test_default_scene(const char *tmp)
     CHECK(!exists(dir, "frame_0000_nurbs.obj"), "NURBS OBJ is off by default");
     CHECK(tmp_files(dir) == 0, "temporary files left in %s", dir);
 
-    cJSON *s = read_summary(dir);
+    cJSON *s = test_read_summary(dir);
     CHECK(s != NULL, "summary.json parses");
     if (s) {
         check_summary_keys(s, 3, 1);
@@ -243,7 +233,7 @@ static void test_cache(const char *tmp)
     CHECK(rc == 0, "cached run exit %d: %s", rc, g_err);
     char dir[512];
     snprintf(dir, sizeof dir, "%s/cache_run", tmp);
-    cJSON *s = read_summary(dir);
+    cJSON *s = test_read_summary(dir);
     const cJSON *c = s ? cJSON_GetObjectItemCaseSensitive(s, "preprocess_cached") : NULL;
     CHECK(cJSON_IsTrue(c), "second run of the default scene reuses the cache");
     CHECK(s && num(s, "steps") == 0 && cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(s, "frames")) == 1,
@@ -264,7 +254,7 @@ static void test_cache(const char *tmp)
              tmp);
     rc = test_run_cli(args, g_out, sizeof g_out, g_err, sizeof g_err);
     CHECK(rc == 0, "--no-cache exit %d: %s", rc, g_err);
-    s = read_summary(dir);
+    s = test_read_summary(dir);
     c = s ? cJSON_GetObjectItemCaseSensitive(s, "preprocess_cached") : NULL;
     CHECK(cJSON_IsFalse(c), "--no-cache preprocesses");
     cJSON_Delete(s);
@@ -289,7 +279,7 @@ static void test_explode(const char *tmp)
     CHECK(!exists(dir, "frame_0002.igs"), "no frame after the failure");
     CHECK(exists(dir, "animation.usda"), "USD written with the frames done");
     CHECK(tmp_files(dir) == 0, "temporary files left in %s", dir);
-    cJSON *s = read_summary(dir);
+    cJSON *s = test_read_summary(dir);
     CHECK(s != NULL, "summary.json written after the failure");
     if (s) {
         CHECK(!strcmp(str(s, "status"), "failed"), "status %s", str(s, "status"));
@@ -414,7 +404,7 @@ static void check_patch_test(const char *dir)
     }
     sem_model_destroy(m0);
     sem_model_destroy(m1);
-    cJSON *s = read_summary(dir);
+    cJSON *s = test_read_summary(dir);
     const cJSON *fr = s ? cJSON_GetObjectItemCaseSensitive(s, "frames") : NULL;
     const cJSON *last = fr ? cJSON_GetArrayItem(fr, cJSON_GetArraySize(fr) - 1) : NULL;
     double mu = 0.5e6, psi = 0.5 * mu * (1.21 - 1.0) - mu * log(1.1);
@@ -442,7 +432,7 @@ static void test_examples(const char *tmp)
         int rc = test_run_cli(args, g_out, sizeof g_out, g_err, sizeof g_err);
         CHECK(rc == 0, "example %s: exit %d: %s", examples[k], rc, g_err);
         CHECK(g_err[0] == '\0', "example %s: --quiet run printed: %s", examples[k], g_err);
-        cJSON *s = read_summary(dir);
+        cJSON *s = test_read_summary(dir);
         CHECK(s != NULL, "example %s: summary.json parses", examples[k]);
         if (s) {
             CHECK(!strcmp(str(s, "status"), "ok"), "example %s: status %s", examples[k], str(s, "status"));
@@ -453,7 +443,7 @@ static void test_examples(const char *tmp)
         if (!strcmp(examples[k], "patch_test")) check_patch_test(dir);
         if (!strcmp(examples[k], "bouncing_sphere")) {
             /* zero gravity, no pins: momentum is conserved (m v0 with v0 = (2, 0, 1)) */
-            cJSON *j = read_summary(dir);
+            cJSON *j = test_read_summary(dir);
             const cJSON *fr = j ? cJSON_GetObjectItemCaseSensitive(j, "frames") : NULL;
             const cJSON *last = fr ? cJSON_GetArrayItem(fr, cJSON_GetArraySize(fr) - 1) : NULL;
             double m = j ? num(j, "mass") : NAN;

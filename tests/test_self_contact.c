@@ -15,7 +15,6 @@
 #include <cjson/cJSON.h>
 
 #include "crossings.h"
-#include "io/mesh_obj_read.h"
 #include "test_util.h"
 
 static double num(const cJSON *o, const char *key)
@@ -55,51 +54,6 @@ static int run_scene(const char *name, const char *tag, int frames, int self, co
     return test_run_cli(args, so, sizeof so, se, se_size);
 }
 
-/* The crossings of every frame of a run (frame 0 the rest shape); the frame with the most
- * in *worst. Returns the total, -1 when a mesh cannot be read. */
-static long run_crossings(const char *dir, int frames, int *worst)
-{
-    char path[1200];
-    sem_triangle_soup rest, frame;
-    sem_error err;
-    snprintf(path, sizeof path, "%s/frame_0000_mesh.obj", dir);
-    if (sem_obj_triangles_read(path, &rest, NULL, &err) != SEM_OK) return -1;
-    long total = 0, most = 0;
-    *worst = -1;
-    for (int k = 0; k <= frames; ++k) {
-        snprintf(path, sizeof path, "%s/frame_%04d_mesh.obj", dir, k);
-        if (sem_obj_triangles_read(path, &frame, NULL, &err) != SEM_OK) {
-            total = -1;
-            break;
-        }
-        long n = frame.n_vertices == rest.n_vertices
-                     ? count_crossings(rest.vertices, frame.vertices, rest.n_vertices, rest.triangles, rest.n_triangles)
-                     : -1;
-        sem_triangle_soup_free(&frame);
-        if (n < 0) {
-            total = -1;
-            break;
-        }
-        if (n > most) {
-            most = n;
-            *worst = k;
-        }
-        total += n;
-    }
-    sem_triangle_soup_free(&rest);
-    return total;
-}
-
-static cJSON *summary(const char *dir)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    char *text = test_slurp(path, NULL);
-    cJSON *s = text ? cJSON_Parse(text) : NULL;
-    free(text);
-    return s;
-}
-
 int main(void)
 {
     const char *tmp = test_tmpdir();
@@ -115,8 +69,8 @@ int main(void)
     int rc = run_scene("beam_fold", "fold_on", frames, -1, tmp, dir, sizeof dir, se, sizeof se);
     CHECK(rc == 0, "beam_fold: exit %d: %s", rc, se);
     int worst;
-    long on = run_crossings(dir, frames, &worst);
-    cJSON *s = summary(dir);
+    long on = run_crossings(dir, frames, 1, 0, &worst);
+    cJSON *s = test_read_summary(dir);
     double gap = INFINITY;
     int touched = 0;
     const cJSON *fr;
@@ -142,7 +96,7 @@ int main(void)
     if (!sanitized) {
         rc = run_scene("beam_fold", "fold_off", frames, 0, tmp, dir, sizeof dir, se, sizeof se);
         CHECK(rc == 0, "beam_fold, self off: exit %d: %s", rc, se);
-        long off = run_crossings(dir, frames, &worst);
+        long off = run_crossings(dir, frames, 1, 0, &worst);
         printf("beam_fold, self-contact off: %ld crossing triangle pairs (most at frame %d)\n", off, worst);
         CHECK(off > 0, "beam_fold without self-contact does not cross itself: the check above proves nothing");
     }

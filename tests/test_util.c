@@ -7,6 +7,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cjson/cJSON.h>
+
 int test_failures = 0;
 int test_checks = 0;
 static int test_skips = 0;
@@ -37,6 +39,16 @@ const char *test_shared_model(const char *relative)
         return NULL;
     }
     return path;
+}
+
+cJSON *test_read_summary(const char *dir)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    char *text = test_slurp(path, NULL);
+    cJSON *s = text ? cJSON_Parse(text) : NULL;
+    free(text);
+    return s;
 }
 
 const char *test_tmpdir(void)

@@ -53,6 +53,8 @@ const char *test_shared_model(const char *relative);
 /* The whole file at path, NUL-terminated (caller frees), its length in *size (may be NULL);
  * NULL when it cannot be read. */
 char *test_slurp(const char *path, size_t *size);
+/* The summary.json of a `sem run` folder, parsed (cJSON; the caller deletes it), or NULL. */
+struct cJSON *test_read_summary(const char *dir);
 /* A fresh temporary directory for this test (removed by the OS / CI clean clone). */
 const char *test_tmpdir(void);
 /* Runs the sem CLI with arguments; captures stdout/stderr into the given buffers

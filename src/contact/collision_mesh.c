@@ -476,6 +476,26 @@ void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int betwe
     sem_bvh_refit(&m->bvh, m->x, m->triangles);
 }
 
+void sem_collision_mesh_box(const sem_collision_mesh *m, const double *x1, double grow, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (int p = 0; p < m->n_points; ++p)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], m->x[3 * (size_t)p + k]);
+            hi[k] = fmax(hi[k], m->x[3 * (size_t)p + k]);
+            if (!x1) continue;
+            lo[k] = fmin(lo[k], x1[3 * (size_t)p + k]);
+            hi[k] = fmax(hi[k], x1[3 * (size_t)p + k]);
+        }
+    for (int k = 0; k < 3; ++k) {
+        lo[k] -= grow;
+        hi[k] += grow;
+    }
+}
+
 void sem_collision_mesh_outward(const sem_collision_mesh *m, int t, int feature, int index, double out[3])
 {
     const double *n = m->face_normal + 3 * (size_t)t;

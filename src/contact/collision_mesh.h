@@ -59,6 +59,8 @@ void sem_collision_mesh_free(sem_collision_mesh *m);
  * and vertex normals and the triangle tree's boxes.
  * The mesh as built has normals at the rest shape. */
 void sem_collision_mesh_update(sem_collision_mesh *m, const double *q, int between);
+/* The box of the points at their positions x and (x1 non-NULL) at x1, widened by grow. */
+void sem_collision_mesh_box(const sem_collision_mesh *m, const double *x1, double grow, double lo[3], double hi[3]);
 /* out = J q (3 per point), the positions alone. */
 void sem_collision_mesh_positions(const sem_collision_mesh *m, const double *q, double *out);
 /* The outward direction at the closest feature of triangle t (narrow_phase.h: feature,

@@ -55,11 +55,6 @@ sem_status sem_barrier_collider_edges(collider *k, sem_error *err)
     return st;
 }
 
-static double object_kappa(const sem_contact *c, double youngs, double length)
-{
-    return c->def.stiffness > 0 ? c->def.stiffness : KAPPA * youngs / length;
-}
-
 /* How far a detection looks: the reach dhat, and margin x the search radius beyond it */
 static double object_reach(const contact_object *co, double margin)
 {
@@ -233,7 +228,7 @@ static void point_pairs(const sem_contact *c, const sem_system *s, int k, int p,
     const sem_collision_mesh *m = &co->mesh;
     const double *x = m->x + 3 * (size_t)p;
     double dhat = co->thickness, reach = object_reach(co, margin);
-    double own = object_kappa(c, co->youngs, co->length) * m->area[p];
+    double own = sem_contact_stiffness(c, co->youngs, co->length) * m->area[p];
     for (int i = 0; i < c->n_colliders; ++i) {
         const collider *col = &c->colliders[i];
         double mu = sqrt(co->friction * col->friction);
@@ -268,7 +263,7 @@ static void point_pairs(const sem_contact *c, const sem_system *s, int k, int p,
         double radius = exclusion_radius(co);
         query q = {c, out, 0, x, NULL, k, {p, -1}, j, -1, cj->mesh.x, cj->mesh.triangles, &cj->mesh,
                    self ? m->x0 + 3 * (size_t)p : NULL, NULL, radius * radius, -1, 0,
-                   object_kappa(c, fmin(co->youngs, cj->youngs), co->length) * m->area[p], dhat,
+                   sem_contact_stiffness(c, fmin(co->youngs, cj->youngs), co->length) * m->area[p], dhat,
                    self ? co->friction : sqrt(co->friction * cj->friction), NULL, NULL};
         run_query(&q, &cj->mesh.bvh, reach);
     }
@@ -289,7 +284,7 @@ static void edge_pairs(const sem_contact *c, const sem_system *s, int k, int e, 
         const collider *col = &c->colliders[i];
         if (col->type != SEM_COLLIDER_MESH) continue;
         query q = {c, out, 1, a0, a1, k, {ea[0], ea[1]}, -1, i, col->vertices, col->edge_tri, NULL, NULL, NULL, 0, -1,
-                   0, object_kappa(c, co->youngs, co->length) * share, dhat, sqrt(co->friction * col->friction), r0, r1};
+                   0, sem_contact_stiffness(c, co->youngs, co->length) * share, dhat, sqrt(co->friction * col->friction), r0, r1};
         run_query(&q, &col->edge_bvh, reach);
     }
     for (int j = k; j < s->n_objects; ++j) {
@@ -299,7 +294,7 @@ static void edge_pairs(const sem_contact *c, const sem_system *s, int k, int e, 
         double radius = exclusion_radius(co);
         query q = {c, out, 1, a0, a1, k, {ea[0], ea[1]}, j, -1, cj->mesh.x, cj->mesh.edge_tri, &cj->mesh,
                    self ? r0 : NULL, self ? r1 : NULL, radius * radius, self ? e : -1, 0,
-                   object_kappa(c, fmin(co->youngs, cj->youngs), co->length) * share, dhat,
+                   sem_contact_stiffness(c, fmin(co->youngs, cj->youngs), co->length) * share, dhat,
                    self ? co->friction : sqrt(co->friction * cj->friction), r0, r1};
         run_query(&q, &cj->mesh.edge_bvh, reach);
     }
@@ -372,27 +367,6 @@ static int near_vertices(sem_contact *c, collider *col, const double lo[3], cons
     return v.n;
 }
 
-/* the box of a mesh's points at x and (x1 non-NULL) at x1, widened by grow */
-static void mesh_box(const sem_collision_mesh *m, const double *x1, double grow, double lo[3], double hi[3])
-{
-    for (int k = 0; k < 3; ++k) {
-        lo[k] = INFINITY;
-        hi[k] = -INFINITY;
-    }
-    for (int p = 0; p < m->n_points; ++p)
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = fmin(lo[k], m->x[3 * (size_t)p + k]);
-            hi[k] = fmax(hi[k], m->x[3 * (size_t)p + k]);
-            if (!x1) continue;
-            lo[k] = fmin(lo[k], x1[3 * (size_t)p + k]);
-            hi[k] = fmax(hi[k], x1[3 * (size_t)p + k]);
-        }
-    for (int k = 0; k < 3; ++k) {
-        lo[k] -= grow;
-        hi[k] += grow;
-    }
-}
-
 void sem_barrier_free_lists(sem_contact *c)
 {
     for (int t = 0; t < c->n_lists; ++t) free(c->lists[t].a);
@@ -457,10 +431,10 @@ sem_status sem_barrier_detect(sem_contact *c, const sem_system *s, const double 
             collider *col = &c->colliders[i];
             if (col->type != SEM_COLLIDER_MESH) continue;
             double lo[3], hi[3];
-            mesh_box(m, NULL, reach, lo, hi);
+            sem_collision_mesh_box(m, NULL, reach, lo, hi);
             int nv = near_vertices(c, col, lo, hi);
             if (nv < 0) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
-            double kappa = object_kappa(c, co->youngs, co->length), mu = sqrt(co->friction * col->friction);
+            double kappa = sem_contact_stiffness(c, co->youngs, co->length), mu = sqrt(co->friction * col->friction);
 #pragma omp parallel num_threads(nthreads)
             {
                 pair_list *mine = &lists[omp_get_thread_num()];
@@ -740,7 +714,7 @@ sem_status sem_contact_max_step(sem_contact *c, const sem_system *s, const doubl
             collider *col = &c->colliders[i];
             if (col->type != SEM_COLLIDER_MESH) continue;
             double lo[3], hi[3];
-            mesh_box(m, co->x1, 0, lo, hi);
+            sem_collision_mesh_box(m, co->x1, 0, lo, hi);
             int nv = near_vertices(c, col, lo, hi);
             if (nv < 0) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory for contacts");
             tk = t;

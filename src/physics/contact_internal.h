@@ -120,14 +120,13 @@ struct sem_contact {
     int n_lists;
 };
 
-/* The collision mesh of contact object i, built on first use. */
-sem_status sem_contact_mesh_for(sem_contact *c, int i, sem_error *err);
+/* The contact stiffness per area: the setting, or KAPPA E / L (E the softer side's modulus,
+ * L the point's object's size). */
+double sem_contact_stiffness(const sem_contact *c, double youngs, double length);
 /* The contact objects of the system's objects (c->sys_to_contact), their meshes built. */
 sem_status sem_contact_map_system(sem_contact *c, const sem_system *s, sem_error *err);
 /* Self-contact on (sem_contact_def.self: 0 the default, on; -1 off). */
 int sem_contact_self_on(const sem_contact *c);
-/* Is triangle t of the mesh collapsed (two corners one welded point)? */
-int sem_contact_collapsed(const sem_collision_mesh *m, int t);
 /* Is the mesh so near a rigid motion of its rest shape that no point can be within the
  * radius of a triangle the self-contact exclusion rule leaves it? */
 int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius);
@@ -136,12 +135,6 @@ int sem_contact_self_far_apart(const sem_collision_mesh *m, double radius);
 int sem_contact_self_far_apart_at(const sem_collision_mesh *m, const double *x, double radius, double rotation[9]);
 /* grad += sum_i w_i f over the weights' dofs */
 void sem_contact_add_gradient(const sem_system *s, const sem_point_weight *w, int n, const double f[3], double *grad);
-/* X = sum_i w_i q_i */
-void sem_contact_relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3]);
-/* The coupling blocks pairs of points of objects a and b need (a != b), into
- * c->couplings once each. */
-sem_status sem_contact_need_coupling(sem_contact *c, const sem_system *s, int a, int pa, int b, int pb,
-                                     sem_error *err);
 
 /* The barrier model (contact_barrier.c). */
 /* Every pair closer than its reach dhat + margin x the search radius (margin 0: the pairs

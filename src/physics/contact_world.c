@@ -205,9 +205,14 @@ sem_status sem_contact_add_object(sem_contact *c, const sem_object *o, sem_error
     return SEM_OK; /* its mesh is built when contact first needs it (mesh_for) */
 }
 
+double sem_contact_stiffness(const sem_contact *c, double youngs, double length)
+{
+    return c->def.stiffness > 0 ? c->def.stiffness : KAPPA * youngs / length;
+}
+
 /* The collision mesh of contact object i, built on first use: a world with one object and
  * no collider never pays for it. */
-sem_status sem_contact_mesh_for(sem_contact *c, int i, sem_error *err)
+static sem_status mesh_for(sem_contact *c, int i, sem_error *err)
 {
     contact_object *co = &c->objects[i];
     if (co->built) return SEM_OK;
@@ -249,14 +254,14 @@ int sem_contact_self_on(const sem_contact *c) { return !c->def.disabled && c->de
 /* Is triangle t of the mesh collapsed (two corners one welded point: at a sphere's pole, a
  * cone's tip)? Its copies share one row (collision_mesh.c), so it stays a segment with no
  * normal to sign a distance by; its neighbours, which share that segment, stand in. */
-int sem_contact_collapsed(const sem_collision_mesh *m, int t)
+static int collapsed(const sem_collision_mesh *m, int t)
 {
     const int *v = m->triangles + 3 * (size_t)t;
     int a = m->weld[v[0]], b = m->weld[v[1]], c = m->weld[v[2]];
     return a == b || b == c || a == c;
 }
 
-static int collapsed_excluded(int t, void *context) { return sem_contact_collapsed(context, t); }
+static int collapsed_excluded(int t, void *context) { return collapsed(context, t); }
 
 /* Self-contact's exclusion rule (SELF_EXCLUSION): is triangle t of the mesh within the
  * excluded rest distance of the point? */
@@ -269,7 +274,7 @@ typedef struct self_exclusion {
 static int self_excluded(int t, void *context)
 {
     const self_exclusion *e = context;
-    if (sem_contact_collapsed(e->mesh, t)) return 1;
+    if (collapsed(e->mesh, t)) return 1;
     const int *v = e->mesh->triangles + 3 * (size_t)t;
     const double *x0 = e->mesh->x0;
     sem_tri_closest cl;
@@ -372,7 +377,7 @@ sem_status sem_contact_map_system(sem_contact *c, const sem_system *s, sem_error
             if (c->objects[i].object == s->objects[k]) c->sys_to_contact[k] = i;
         if (c->sys_to_contact[k] < 0)
             return sem_error_set(err, SEM_ERR_INVALID, "contact: an object of the system is not in the world");
-        sem_status st = sem_contact_mesh_for(c, c->sys_to_contact[k], err);
+        sem_status st = mesh_for(c, c->sys_to_contact[k], err);
         if (st != SEM_OK) return st;
     }
     return SEM_OK;
@@ -395,7 +400,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
     const contact_object *co = &c->objects[c->sys_to_contact[k]];
     const sem_collision_mesh *m = &co->mesh;
     double th = co->thickness, L = co->length;
-    double own_stiffness = c->def.stiffness > 0 ? c->def.stiffness : KAPPA * co->youngs / L;
+    double own_stiffness = sem_contact_stiffness(c, co->youngs, L);
     double radius = th + SEARCH_DEPTH * L;
     /* how far to look: the search radius, or the contacts within th + margin x radius */
     double reach = margin > 1 ? th + margin * radius : radius, reach2 = reach * reach;
@@ -466,7 +471,7 @@ static int point_contacts(const sem_contact *c, const sem_system *s, int k, int 
         if (r.d < *min_gap && r.d < radius) *min_gap = r.d;
         if (!(r.d < th + margin * radius)) continue;
         double E = co->youngs < cj->youngs ? co->youngs : cj->youngs;
-        r.stiffness = (c->def.stiffness > 0 ? c->def.stiffness : KAPPA * E / L) * m->area[p];
+        r.stiffness = sem_contact_stiffness(c, E, L) * m->area[p];
         r.mu = sqrt(co->friction * cj->friction);
         out[n++] = r;
     }
@@ -553,7 +558,7 @@ void sem_contact_add_gradient(const sem_system *s, const sem_point_weight *w, in
     }
 }
 
-void sem_contact_relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
+static void relative_point(const sem_system *s, const sem_point_weight *w, int n, const double *q, double X[3])
 {
     X[0] = X[1] = X[2] = 0;
     for (int i = 0; i < n; ++i) {
@@ -581,7 +586,7 @@ static sem_status springs(sem_contact *c, const sem_system *s, double *grad, sem
         if (v && !(r->d < r->thickness)) {
             double X[3];
             n = rec_weights(c, r, w);
-            sem_contact_relative_point(s, w, n, v, X);
+            relative_point(s, w, n, v, X);
             if (!(r->d + h * dot3(X, r->n) < r->thickness)) continue;
             slope = r->stiffness * (r->d - r->thickness);
         } else if (!(r->d < r->thickness))
@@ -612,7 +617,7 @@ static sem_status friction(sem_contact *c, const sem_system *s, const double *q,
         friction_rec *fr = &c->friction[i];
         const sem_point_weight *w = c->fweights + fr->first;
         double X[3], u[2], g[2], Hu[4];
-        sem_contact_relative_point(s, w, fr->count, q, X);
+        relative_point(s, w, fr->count, q, X);
         for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
         u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
         u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
@@ -663,7 +668,7 @@ static sem_status friction_damper(sem_contact *c, const sem_system *s, const dou
         const friction_rec *fr = &c->friction[i];
         const sem_point_weight *w = c->fweights + fr->first;
         double X[3], u[2], g[2];
-        sem_contact_relative_point(s, w, fr->count, qpred, X);
+        relative_point(s, w, fr->count, qpred, X);
         for (int d = 0; d < 3; ++d) X[d] -= fr->X0[d];
         u[0] = fr->T[0] * X[0] + fr->T[2] * X[1] + fr->T[4] * X[2];
         u[1] = fr->T[1] * X[0] + fr->T[3] * X[1] + fr->T[5] * X[2];
@@ -699,8 +704,9 @@ static double *system_q(const sem_system *s, double a, double b)
 /* ---------------------------------------------------------------------------------- */
 /* the step                                                                            */
 
-sem_status sem_contact_need_coupling(sem_contact *c, const sem_system *s, int a, int pa, int b, int pb,
-                                     sem_error *err)
+/* The coupling block that points pa of system object a and pb of object b (a != b) need,
+ * into c->couplings once. */
+static sem_status need_coupling(sem_contact *c, const sem_system *s, int a, int pa, int b, int pb, sem_error *err)
 {
     const sem_collision_mesh *m = &c->objects[c->sys_to_contact[a]].mesh;
     const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[b]].mesh;
@@ -726,14 +732,14 @@ static sem_status needed_couplings(sem_contact *c, const sem_system *s, sem_erro
         const contact_rec *r = &c->recs[i];
         if (r->other < 0 || r->other == r->k) continue; /* self-contact: the object's own blocks */
         const sem_collision_mesh *mo = &c->objects[c->sys_to_contact[r->other]].mesh;
-        st = sem_contact_need_coupling(c, s, r->k, r->point, r->other, mo->triangles[3 * r->triangle], err);
+        st = need_coupling(c, s, r->k, r->point, r->other, mo->triangles[3 * r->triangle], err);
     }
     for (int i = 0; i < c->n_pairs && st == SEM_OK && def_is_barrier(c); ++i) {
         const barrier_pair *p = &c->pairs[i];
         for (int u = 0; u < p->nv && st == SEM_OK; ++u)
             for (int v = u + 1; v < p->nv && st == SEM_OK; ++v)
                 if (p->object[u] >= 0 && p->object[v] >= 0 && p->object[u] != p->object[v])
-                    st = sem_contact_need_coupling(c, s, p->object[u], p->point[u], p->object[v], p->point[v], err);
+                    st = need_coupling(c, s, p->object[u], p->point[u], p->object[v], p->point[v], err);
     }
     return st;
 }
@@ -832,7 +838,7 @@ sem_status sem_contact_begin_step(sem_contact *c, sem_system **system, double h,
         memcpy(c->fweights + c->n_fweights, w, (size_t)n * sizeof *w);
         c->n_fweights += n;
         sem_tangent_basis(normal, fr->T);
-        sem_contact_relative_point(s, w, n, q, fr->X0);
+        relative_point(s, w, n, q, fr->X0);
         fr->mu_lambda = mu * lambda;
         fr->slipping = -1;
     }
@@ -907,20 +913,11 @@ sem_status sem_contact_check_islands(sem_contact *c, sem_object *const *objects,
         for (int k = 0; k < c->n_objects && ci < 0; ++k)
             if (c->objects[k].object == objects[i]) ci = k;
         st = ci < 0 ? sem_error_set(err, SEM_ERR_INVALID, "contact: an object is not in the world")
-                    : sem_contact_mesh_for(c, ci, err);
+                    : mesh_for(c, ci, err);
         if (st != SEM_OK) break;
         contact_object *co = &c->objects[ci];
         sem_collision_mesh_update(&co->mesh, objects[i]->q, 0);
-        double *b = box + 6 * (size_t)i;
-        for (int k = 0; k < 3; ++k) {
-            b[k] = INFINITY;
-            b[3 + k] = -INFINITY;
-        }
-        for (int p = 0; p < co->mesh.n_points; ++p)
-            for (int k = 0; k < 3; ++k) {
-                b[k] = fmin(b[k], co->mesh.x[3 * (size_t)p + k] - co->thickness);
-                b[3 + k] = fmax(b[3 + k], co->mesh.x[3 * (size_t)p + k] + co->thickness);
-            }
+        sem_collision_mesh_box(&co->mesh, NULL, co->thickness, box + 6 * (size_t)i, box + 6 * (size_t)i + 3);
     }
     for (int i = 0; i < n && st == SEM_OK; ++i)
         for (int j = i + 1; j < n && st == SEM_OK; ++j) {
@@ -959,7 +956,7 @@ sem_status sem_contact_islands(sem_contact *c, sem_object *const *objects, int n
         for (int k = 0; k < c->n_objects && ci < 0; ++k)
             if (c->objects[k].object == objects[i]) ci = k;
         sem_status st = ci < 0 ? sem_error_set(err, SEM_ERR_INVALID, "contact: an object is not in the world")
-                               : sem_contact_mesh_for(c, ci, err);
+                               : mesh_for(c, ci, err);
         if (st != SEM_OK) {
             free(box);
             return st;

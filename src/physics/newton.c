@@ -149,6 +149,17 @@ static sem_status factorize(sem_world *w, sem_system *s, double cM, double cD, s
     return st;
 }
 
+/* Free control points of q back to where they are in qn (pinned ones keep their targets). */
+static void free_points_at(const sem_system *s, double *q, const double *qn)
+{
+    for (int k = 0; k < s->n_objects; ++k) {
+        const sem_object *o = s->objects[k];
+        size_t off = s->dof_offset[k];
+        for (int c = 0; c < o->n_ctrl; ++c)
+            if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
+    }
+}
+
 /* The barrier model's first iterate (q, pinned points at their targets): kept if the
  * straight move from q_n reaches it without a crossing; otherwise free points start at q_n,
  * and a crossing then is the pins' (prescribed motion into a surface): an error. scratch:
@@ -162,12 +173,7 @@ static sem_status barrier_start(sem_world *w, sem_system *s, double *q, const do
         sem_status st = sem_contact_max_step(w->contact, s, qn, scratch, 1.0, &t, err);
         if (st != SEM_OK || t >= 1) return st;
         if (pass == 1) break;
-        for (int k = 0; k < s->n_objects; ++k) {
-            const sem_object *o = s->objects[k];
-            size_t off = s->dof_offset[k];
-            for (int c = 0; c < o->n_ctrl; ++c)
-                if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
-        }
+        free_points_at(s, q, qn);
     }
     return sem_error_set(err, SEM_ERR_NUMERIC,
                          "contact (barrier): the prescribed motion of pinned points takes a surface into another "
@@ -242,12 +248,7 @@ sem_status sem_newton_solve(sem_world *w, sem_system *s, double h, double t1, in
              * carry a part through the contact springs far enough to invert an element
              * (infinite energy, no gradient). Newton then starts from q_n instead (free points
              * where they were), which is valid: it is the last accepted state. */
-            for (int k = 0; k < s->n_objects; ++k) {
-                const sem_object *o = s->objects[k];
-                size_t off = s->dof_offset[k];
-                for (int c = 0; c < o->n_ctrl; ++c)
-                    if (!o->pinned[c]) memcpy(q + off + 3 * (size_t)c, qn + off + 3 * (size_t)c, 3 * sizeof(double));
-            }
+            free_points_at(s, q, qn);
             st = gradient(&nt, q, g, gq, &vc0, err);
         }
         if (st != SEM_OK) goto done;
