@@ -150,18 +150,23 @@ int main(void)
      * frame 22; tire: error energy 57 % at frame 6; chicken: seams 5 % at frame 18 (17 % later);
      * starship: error energy 65 % at frame 67; soft mug: seams 2.5 % at frame 14 (36 % later);
      * astronauts: seams 1.1 % at frame 31 (3 % later). That is issue 28's item 3; a scene made
-     * right there changes its entry to NULL. */
+     * right there changes its entry to NULL. Seventeenth session: seam ties (sem.seam_ties,
+     * default 10; docs/simulation.md "Seam ties") hold the faces together - largest openings
+     * over these frames rockets 0.033 %, chicken 0.49 %, soft mug 0.51 %, astronauts 0.17 %,
+     * starship 0.0006 %, tire 0.023 % - so the chicken and the astronauts are ok and no scene
+     * is suspect for its seams any more; the error energy (rockets, tire, starship, the stiff
+     * mug) remains. */
     static const scene_case cases[] = {
-        {"rockets", 22, 1, 0, "seam energy"},
+        {"rockets", 22, 1, 0, "energy"},
         {"tire_slope", 10, 1, 0, "energy"},
-        {"chicken_drop", 20, 0, 0, "seam energy"},
-        {"starship_mars", 70, 0, 0, "seam energy"},
+        {"chicken_drop", 20, 0, 0, NULL},
+        {"starship_mars", 70, 0, 0, "energy"},
         /* the soft mug (E 1e4, a jelly that sags under its own weight: rho g L ~ E) lands
          * on springs scaled by its own modulus, 1000 E / L per area: 3.7 cm deep, 5.4 % of
          * the size, in the eighth session; 6 % here, and stiffer springs for such soft
          * objects left open (docs/simulation.md) */
-        {"mugs", 25, 0, 0.06, "seam energy"},
-        {"astronauts", 60, 0, 0, "seam"},
+        {"mugs", 25, 0, 0.06, "energy"},
+        {"astronauts", 60, 0, 0, NULL},
     };
     int sanitized = getenv("SEM_SANITIZED") != NULL;
     const char *tmp = test_tmpdir();

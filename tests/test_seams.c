@@ -118,28 +118,40 @@ static void test_box_seams(void)
     sem_model_destroy(m);
 }
 
-/* A world of one box (degree 2: the quadratic polynomials reproduce it), at rest. */
-static int make_world(test_setup *t)
+/* A world of one box (degree 2: the quadratic polynomials reproduce it), at rest, with seam
+ * ties of stiffness ties (0: none) and its top face (part 5) raised by gap at rest. */
+static int make_world_ties(test_setup *t, double ties, double gap)
 {
     memset(t, 0, sizeof *t);
     sem_error err;
     t->model = make_box(2);
     if (!t->model) return 0;
+    if (gap != 0) {
+        sem_surface *top = &t->model->parts[5].surface;
+        for (int c = 0; c < top->n_u * top->n_v; ++c) top->ctrl[3 * (size_t)c + 2] += gap;
+    }
     sem_preprocess_options po = sem_default_preprocess_options();
     if (sem_preprocess(t->model, &po, &t->disc, &err) != SEM_OK) {
         CHECK(0, "preprocess: %s", err.message);
         return 0;
     }
     sem_world_def wd = sem_default_world_def();
+    if (gap != 0) wd.gravity[2] = 0;
     t->world = sem_world_create(&wd, &err);
     sem_object_def od = sem_default_object_def();
     od.model = t->model;
     od.disc = t->disc;
+    od.seam_ties = ties;
     if (!t->world || sem_world_add_object(t->world, &od, &err) < 0) {
         CHECK(0, "world: %s", err.message);
         return 0;
     }
     return 1;
+}
+
+static int make_world(test_setup *t)
+{
+    return make_world_ties(t, 0, 0);
 }
 
 static void test_world_checks(void)
@@ -192,6 +204,84 @@ static void test_world_checks(void)
     free(q);
     free(qs);
     test_setup_free(&t);
+}
+
+static double error_energy_of(test_setup *t, const double *q)
+{
+    sem_world_object_set_state(t->world, 0, q, NULL);
+    sem_object_stats st;
+    sem_world_object_stats(t->world, 0, &st);
+    return st.error_energy;
+}
+
+/* Seam ties (sem_object_def.seam_ties, k = 10) on the 2 x 1 x 0.5 box (E 1e6 by default):
+ * - at rest and under an affine motion (rotation, stretch, shift) they store nothing (below
+ *   1e-10 of E V x the motion's strain squared: round-off of the error matrix);
+ * - the top face out by d: its four edges (length 6) open by d, seen from the face and from
+ *   its neighbours, so the ties add k E (6 + 6) d^2 to the error energy (closed form; the
+ *   walk's points stand for the boundary's length up to its corners, 2 %);
+ * - a box whose top face stands 2e-4 of the size off its neighbours at rest (a CAD gap
+ *   within the seam tolerance) keeps its gap: at rest it stores nothing and feels no force
+ *   (a step without gravity leaves every control point where it was, to 1e-10 of the size). */
+static void test_seam_ties(void)
+{
+    test_setup t0, t1;
+    if (!make_world_ties(&t0, 0, 0) || !make_world_ties(&t1, 10, 0)) {
+        test_setup_free(&t0);
+        test_setup_free(&t1);
+        return;
+    }
+    const double E = sem_default_material().youngs_modulus, V = 1.0, size = sqrt(2 * 2 + 1 + 0.25);
+    int n = sem_world_object_dofs(t1.world, 0);
+    double *q0 = malloc((size_t)n * sizeof *q0), *q = malloc((size_t)n * sizeof *q);
+    memcpy(q0, sem_world_object_q(t1.world, 0), (size_t)n * sizeof *q0);
+    CHECK(fabs(error_energy_of(&t1, q0)) < 1e-12 * E * V, "ties at rest: error energy %g", error_energy_of(&t1, q0));
+    /* rotation about z by 0.4 rad, stretch 1.2 along x, shift (1, 2, 3): strain 0.2 */
+    double c = cos(0.4), sn = sin(0.4);
+    for (int p = 0; p < n / 3; ++p) {
+        const double *x = q0 + 3 * p;
+        q[3 * p + 0] = 1.2 * c * x[0] - sn * x[1] + 1;
+        q[3 * p + 1] = 1.2 * sn * x[0] + c * x[1] + 2;
+        q[3 * p + 2] = x[2] + 3;
+    }
+    double affine = error_energy_of(&t1, q);
+    CHECK(fabs(affine) < 1e-10 * E * V * 0.04, "ties under an affine motion: error energy %g", affine);
+    /* the top face out by d */
+    size_t off[7];
+    sem_model_part_offsets(t1.model, off);
+    double d = 0.01;
+    memcpy(q, q0, (size_t)n * sizeof *q);
+    for (size_t p = off[5]; p < off[6]; ++p) q[3 * p + 2] += d;
+    double with = error_energy_of(&t1, q), without = error_energy_of(&t0, q);
+    printf("top face out by %g m: error energy %.6g J with seam ties, %.6g J without; ties' share %.6g J, "
+           "closed form %.6g J\n",
+           d, with, without, with - without, 10 * E * 12 * d * d);
+    CHECK_REL(with - without, 10 * E * 12 * d * d, 0.02);
+    free(q0);
+    free(q);
+    test_setup_free(&t0);
+    test_setup_free(&t1);
+    /* a rest gap */
+    test_setup tg;
+    double gap = 2e-4 * size;
+    if (!make_world_ties(&tg, 10, gap)) {
+        test_setup_free(&tg);
+        return;
+    }
+    n = sem_world_object_dofs(tg.world, 0);
+    q0 = malloc((size_t)n * sizeof *q0);
+    memcpy(q0, sem_world_object_q(tg.world, 0), (size_t)n * sizeof *q0);
+    sem_object_stats st;
+    sem_world_object_stats(tg.world, 0, &st);
+    CHECK(fabs(st.error_energy) < 1e-9 * 10 * E * 12 * gap * gap, "rest gap: error energy at rest %g", st.error_energy);
+    sem_error err;
+    double moved = 0;
+    for (int k = 0; k < 3; ++k) CHECK(sem_world_step(tg.world, &err) == SEM_OK, "step: %s", err.message);
+    const double *qs = sem_world_object_q(tg.world, 0);
+    for (int i = 0; i < n; ++i) moved = fmax(moved, fabs(qs[i] - q0[i]));
+    CHECK(moved < 1e-10 * size, "rest gap: a step moved a control point by %g", moved);
+    free(q0);
+    test_setup_free(&tg);
 }
 
 /* The 10-section cantilever (static, gravity, clamped at x = 0, defaults otherwise) with
@@ -335,6 +425,7 @@ int main(void)
 {
     test_box_seams();
     test_world_checks();
+    test_seam_ties();
     test_welded_beam();
     test_run_status();
     return test_finish("test_seams");

@@ -52,6 +52,8 @@ typedef struct sem_seams {
     int *row_ctrl;         /* control point index in the model's q order */
     double *row_w;         /* rational basis value */
     double *rest_distance; /* per pair, at rest */
+    double *length;        /* per pair: the length of part a's boundary its point stands for
+                            * (the walk's spacing there; 0 at a pole) */
     double size;           /* model size used (diagonal of the boundary's bounding box) */
     double tolerance;      /* the distance below which points paired, model units */
 } sem_seams;

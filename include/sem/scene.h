@@ -59,6 +59,8 @@ typedef struct sem_scene_object {
     int seams;                 /* sem.seams: sem_object_def.seams (default SEM_SEAMS_GEOMETRIC) */
     int weld;                  /* sem.weld: sem_object_def.weld (default -1: on with
                                   sem.resolution, else off) */
+    double seam_ties;          /* sem.seam_ties: sem_object_def.seam_ties (default
+                                  SEM_DEFAULT_SEAM_TIES; 0: the paper's coupling) */
     /* sem.resolution R (default 0: off): the accuracy setting. Every part is cut into patches
      * of at most L / R (L the model's bounding-box diagonal), each with its own polynomial
      * (sem_model_patches); the frames hold the file's parts, refined at the cuts. */

@@ -189,10 +189,23 @@ typedef struct sem_object_def {
     int n_region_loads;
     double friction;                     /* Coulomb coefficient of its surface
                                             (sem_default_object_def: SEM_DEFAULT_FRICTION) */
+    /* Seam ties k (dimensionless; sem_default_object_def: 0, the paper's coupling; scenes:
+     * SEM_DEFAULT_SEAM_TIES): points where two parts meet at rest (the seam monitor's pairs,
+     * sem/measure.h) are held together by the energy k E sum ds |x_a - x_b - d0|^2 (ds the
+     * boundary length a pair stands for, d0 its rest gap), a penalty coupling of the faces
+     * along their shared edges (docs/simulation.md, "Seam ties"). It vanishes for every
+     * motion of the body as a whole, so the patch test and momentum stay. Applied with the
+     * q-space solvers; the structured solver keeps the paper's coupling. */
+    double seam_ties;
 } sem_object_def;
 
 #define SEM_DEFAULT_BLEND 0.02
+/* The scenes' seam tie stiffness (sem_object_def.seam_ties; docs/simulation.md). */
+#define SEM_DEFAULT_SEAM_TIES 10.0
 #define SEM_WELD_TOLERANCE 1e-9
+/* Seam ties (sem_object_def.seam_ties) join the seam pairs whose points are at most this
+ * far apart at rest, relative to the model's size. */
+#define SEM_SEAM_TIE_GAP 1e-3
 #ifndef SEM_WELD_STIFFNESS
 #define SEM_WELD_STIFFNESS 1e3
 #endif

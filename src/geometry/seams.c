@@ -48,17 +48,20 @@ typedef struct point_list {
     int n, cap;
     double *uv; /* 2 per point */
     double *X;  /* 3 per point */
+    double *ds; /* per point: the walk's spacing there (the boundary length it stands for) */
 } point_list;
 
-static int point_push(point_list *l, const double uv[2], const double X[3])
+static int point_push(point_list *l, const double uv[2], const double X[3], double ds)
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
         if (!sem_resize((void **)&l->uv, (size_t)cap * 2, sizeof(double)) ||
-            !sem_resize((void **)&l->X, (size_t)cap * 3, sizeof(double)))
+            !sem_resize((void **)&l->X, (size_t)cap * 3, sizeof(double)) ||
+            !sem_resize((void **)&l->ds, (size_t)cap, sizeof(double)))
             return -1;
         l->cap = cap;
     }
+    l->ds[l->n] = ds;
     memcpy(l->uv + 2 * (size_t)l->n, uv, 2 * sizeof(double));
     memcpy(l->X + 3 * (size_t)l->n, X, 3 * sizeof(double));
     l->n++;
@@ -69,6 +72,7 @@ static void point_list_free(point_list *l)
 {
     free(l->uv);
     free(l->X);
+    free(l->ds);
 }
 
 static double dist3(const double *a, const double *b)
@@ -92,7 +96,7 @@ static int walk_loop(const sem_surface *s, const double *uv, int n, double h, po
     int rc = 0;
     if (!(length > 0)) {
         /* a loop collapsed to a point (a pole): one point */
-        rc = point_push(out, uv, X);
+        rc = point_push(out, uv, X, 0.0);
         free(X);
         return rc;
     }
@@ -107,7 +111,7 @@ static int walk_loop(const sem_surface *s, const double *uv, int n, double h, po
             double t = (next - run) / seg;
             double p[2] = {ua[0] + t * (ub[0] - ua[0]), ua[1] + t * (ub[1] - ua[1])}, x[3];
             sem_surface_eval(s, p[0], p[1], x, NULL, NULL, NULL);
-            rc = point_push(out, p, x);
+            rc = point_push(out, p, x, step);
         }
         run += seg;
     }
@@ -160,18 +164,21 @@ typedef struct pair_list {
     int *part;   /* 2 per pair */
     double *uv;  /* 4 per pair */
     double *rest; /* per pair */
+    double *ds;   /* per pair: the boundary length its first point stands for */
 } pair_list;
 
-static int pair_push(pair_list *l, int a, const double uva[2], int b, const double uvb[2], double rest)
+static int pair_push(pair_list *l, int a, const double uva[2], int b, const double uvb[2], double rest, double ds)
 {
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 64;
         if (!sem_resize((void **)&l->part, (size_t)cap * 2, sizeof(int)) ||
             !sem_resize((void **)&l->uv, (size_t)cap * 4, sizeof(double)) ||
-            !sem_resize((void **)&l->rest, (size_t)cap, sizeof(double)))
+            !sem_resize((void **)&l->rest, (size_t)cap, sizeof(double)) ||
+            !sem_resize((void **)&l->ds, (size_t)cap, sizeof(double)))
             return -1;
         l->cap = cap;
     }
+    l->ds[l->n] = ds;
     l->part[2 * l->n] = a;
     l->part[2 * l->n + 1] = b;
     memcpy(l->uv + 4 * (size_t)l->n, uva, 2 * sizeof(double));
@@ -186,6 +193,7 @@ static void pair_list_free(pair_list *l)
     free(l->part);
     free(l->uv);
     free(l->rest);
+    free(l->ds);
 }
 
 /* The point of part b nearest X that lies on b (inside its trim), if within tol:
@@ -215,10 +223,42 @@ static int partner(const sem_surface_sampler *sampler, const sem_trim_region *re
     return 1;
 }
 
+/* A pair found d > 0 apart: the two points of the same place are usually closer. Near a
+ * corner the walk's point X of part a pairs with the corner of b (which lies on a too), and
+ * where two faces meet along an edge at an angle, X's nearest point of b is a little off the
+ * edge. Alternating projections (a's point onto b, b's onto a) shrink the distance towards
+ * the surfaces' common curve, or to a gap's true width; a point is moved only while the pair
+ * gets closer and stays within tol of X. uva, uvb: in, the pair; out, the closer pair.
+ * Returns its distance. */
+static double closest_pair(const sem_surface_sampler *sa, const sem_surface_sampler *sb, const double X[3],
+                           double tol, double uva[2], double uvb[2], double d)
+{
+    double xa[3], xb[3];
+    memcpy(xa, X, sizeof xa);
+    sem_surface_eval(sb->surface, uvb[0], uvb[1], xb, NULL, NULL, NULL);
+    for (int it = 0; it < 8 && d > 1e-12 * tol; ++it) {
+        double t[2] = {uva[0], uva[1]}, y[3];
+        double e = sem_surface_closest_point(sa, xb, uva, 0.0, t);
+        sem_surface_eval(sa->surface, t[0], t[1], y, NULL, NULL, NULL);
+        if (!(e < d) || dist3(y, X) > tol) break;
+        memcpy(uva, t, sizeof t);
+        memcpy(xa, y, sizeof y);
+        d = e;
+        t[0] = uvb[0], t[1] = uvb[1];
+        e = sem_surface_closest_point(sb, xa, uvb, 0.0, t);
+        sem_surface_eval(sb->surface, t[0], t[1], y, NULL, NULL, NULL);
+        if (!(e < d) || dist3(y, X) > tol) break;
+        memcpy(uvb, t, sizeof t);
+        memcpy(xb, y, sizeof y);
+        d = e;
+    }
+    return d;
+}
+
 void sem_seams_free(sem_seams *s)
 {
     if (!s) return;
-    SEM_FREE_ALL(s->part, s->row_start, s->row_ctrl, s->row_w, s->rest_distance);
+    SEM_FREE_ALL(s->part, s->row_start, s->row_ctrl, s->row_w, s->rest_distance, s->length);
     memset(s, 0, sizeof *s);
 }
 
@@ -306,9 +346,10 @@ sem_status sem_seams_build(const sem_model *model, double tolerance, sem_seams *
                 if (X[0] < bb[0] - tol || X[1] < bb[1] - tol || X[2] < bb[2] - tol || X[0] > bb[3] + tol ||
                     X[1] > bb[4] + tol || X[2] > bb[5] + tol)
                     continue;
-                double uv[2], d;
+                double uv[2], d, uva[2] = {boundary[a].uv[2 * (size_t)i], boundary[a].uv[2 * (size_t)i + 1]};
                 if (!partner(&samplers[b], regions[b], &boundary[b], X, tol, uv, &d)) continue;
-                if (pair_push(&pairs[a], a, boundary[a].uv + 2 * (size_t)i, b, uv, d) != 0) {
+                d = closest_pair(&samplers[a], &samplers[b], X, tol, uva, uv, d);
+                if (pair_push(&pairs[a], a, uva, b, uv, d, boundary[a].ds[i]) != 0) {
                     failed = 1;
                     break;
                 }
@@ -334,11 +375,12 @@ sem_status sem_seams_build(const sem_model *model, double tolerance, sem_seams *
     }
     out->part = malloc((size_t)n * 2 * sizeof(int));
     out->rest_distance = malloc((size_t)n * sizeof(double));
+    out->length = malloc((size_t)n * sizeof(double));
     out->row_start = malloc(((size_t)2 * n + 1) * sizeof(int));
     out->row_ctrl = malloc((size_t)2 * n * max_row * sizeof(int));
     out->row_w = malloc((size_t)2 * n * max_row * sizeof(double));
     int *index = malloc((size_t)max_row * sizeof(int));
-    if (!out->part || !out->rest_distance || !out->row_start || !out->row_ctrl || !out->row_w || !index) {
+    if (!out->part || !out->rest_distance || !out->length || !out->row_start || !out->row_ctrl || !out->row_w || !index) {
         free(index);
         sem_seams_free(out);
         st = sem_error_set(err, SEM_ERR_NOMEM, "out of memory finding the model's seams");
@@ -351,6 +393,7 @@ sem_status sem_seams_build(const sem_model *model, double tolerance, sem_seams *
             out->part[2 * k] = pairs[p].part[2 * i];
             out->part[2 * k + 1] = pairs[p].part[2 * i + 1];
             out->rest_distance[k] = pairs[p].rest[i];
+            out->length[k] = pairs[p].ds[i];
             for (int side = 0; side < 2; ++side) {
                 int part = pairs[p].part[2 * i + side];
                 const double *uv = pairs[p].uv + 4 * (size_t)i + 2 * side;

@@ -343,6 +343,25 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
                 }
         }
     }
+    /* the seam ties (object_seam_ties.c): rows J_a - J_b */
+    for (int t = 0; t < o->n_seam_ties; ++t) {
+        const sem_seams *sm = &o->seams;
+        int k = o->seam_tie_pair[t], a1 = sm->row_start[2 * k + 1];
+        int e0 = sm->row_start[2 * k], e1 = sm->row_start[2 * k + 2];
+        double wgt = o->seam_tie_weight[t];
+        for (int x = e0; x < e1; ++x) {
+            double vx = x < a1 ? sm->row_w[x] : -sm->row_w[x];
+            int cx = sm->row_ctrl[x], gx = o->ctrl_group[cx];
+            for (int y = e0; y < e1; ++y) {
+                double vy = y < a1 ? sm->row_w[y] : -sm->row_w[y];
+                int cy = sm->row_ctrl[y], gy = o->ctrl_group[cy];
+                int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
+                size_t nb = sem_group_size(o, gy);
+                o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[cx] * nb + (size_t)o->ctrl_local[cy]] +=
+                    wgt * vx * vy;
+            }
+        }
+    }
     /* Error matrix (Eq. 16) as a sum of outer products of its rows' residuals r (Gamma_s - J_s,
      * or P_i(X_s) Pi_i - J_s on a split seam: sem_error_rows), so it is positive
      * semi-definite by construction. The factored form Pi^T(...)Pi - ... + J^T A J cancels

@@ -20,6 +20,7 @@
  *   assembly.c       the shared basis, point lists, z-space work, K_blocks,
  *                    elastic_energy, qc
  *   object_welds.c   n_welds, weld_ctrl
+ *   object_seam_ties.c n_seam_ties, seam_tie_pair, seam_tie_weight (and seams, built early)
  *   pins.c           pins (material pins: the anchored points)
  *   mass_error.c     entry_basis, point_pairs, M_blocks, E_blocks and their CSR copy,
  *                    A_blocks (the pins' anchor), n_orphans, part_tied
@@ -92,6 +93,11 @@ typedef struct sem_object {
     int n_orphans;             /* control points tied to their part's polynomial (no samples) */
     int n_welds;               /* welded pairs (object_welds.c): weld_ctrl[2k], [2k + 1] */
     int *weld_ctrl;
+    int n_seam_ties;           /* seam pairs tied (object_seam_ties.c): indices into seams */
+    int *seam_tie_pair;
+    double *seam_tie_weight;   /* per tie: its row's weight in the error matrix */
+    double *f_seam;            /* the ties' rest-gap force, 3 n_ctrl, or NULL (no gap) */
+    double seam_c0;            /* gamma sum w |d0|^2 over the ties */
     int *part_tied;            /* per part: how many of its control points are tied */
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
@@ -140,6 +146,11 @@ sem_status sem_object_layout_init(sem_object *o, sem_error *err);
 /* object_welds.c: the pairs of control points that coincide at rest (sem_object_def.weld),
  * each point of a cluster paired with the cluster's lowest index. */
 sem_status sem_object_find_welds(sem_object *o, sem_error *err);
+/* Seam ties (object_seam_ties.c) of stiffness k (<= 0: none); needs o->gamma. */
+sem_status sem_object_find_seam_ties(sem_object *o, double stiffness, sem_error *err);
+/* What the ties' rest gaps add to gamma q^T M_eps q to make the error energy (0 without
+ * gaps). */
+double sem_seam_ties_gap_energy(const sem_object *o, const double *q);
 /* The largest group (at least 1). */
 size_t sem_max_group_size(const sem_object *o);
 

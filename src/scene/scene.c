@@ -278,7 +278,7 @@ static sem_status parse_sem(ctx *c, const cJSON *s, const char *where, sem_prepr
     static const char *const keys[] = {"order", "alpha", "sparsity", "spacing", "rays",
                                        "ray_axis", "points_per_interval", "gamma",
                                        "tessellation", "weight_threshold", "origins", "fit", "blend", "seams", "weld",
-                                       "resolution", NULL};
+                                       "seam_ties", "resolution", NULL};
     sem_status st = check_keys(c, s, where, keys);
     if (st != SEM_OK) return st;
     char w[256];
@@ -599,6 +599,7 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
     obj->sem = sem_default_preprocess_options();
     obj->blend = SEM_DEFAULT_BLEND;
     obj->weld = -1; /* with sem.resolution */
+    obj->seam_ties = SEM_DEFAULT_SEAM_TIES;
     if ((st = parse_shape(c, o, where, base_dir, obj)) != SEM_OK) return st;
     obj->friction = SEM_DEFAULT_FRICTION;
     if ((st = get_number(c, o, "friction", where, &obj->friction)) != SEM_OK) return st;
@@ -651,6 +652,15 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
                 char w2[300];
                 snprintf(w2, sizeof w2, "%s.resolution", w);
                 return fail(c, w2, "must be in 0..%d or null (got %g)", SEM_MAX_RESOLUTION, obj->resolution);
+            }
+        }
+        const cJSON *ties = cJSON_GetObjectItemCaseSensitive(s, "seam_ties");
+        if (ties && !cJSON_IsNull(ties)) {
+            if ((st = get_number(c, s, "seam_ties", w, &obj->seam_ties)) != SEM_OK) return st;
+            if (!(obj->seam_ties >= 0) || obj->seam_ties > 1e6) {
+                char w2[300];
+                snprintf(w2, sizeof w2, "%s.seam_ties", w);
+                return fail(c, w2, "must be in 0..1e6 or null (got %g)", obj->seam_ties);
             }
         }
         const cJSON *bl = cJSON_GetObjectItemCaseSensitive(s, "blend");

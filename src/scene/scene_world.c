@@ -499,6 +499,7 @@ static sem_status add_object(sem_scene_world *sw, int i, const sem_scene_world_o
     od.disc = sw->discs[i];
     od.material = so->material;
     od.blend = so->blend;
+    od.seam_ties = so->seam_ties;
     od.seams = so->seams;
     od.weld = so->weld >= 0 ? so->weld : so->resolution > 0;
     od.part_material = sw->part_material[i];
