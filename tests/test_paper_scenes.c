@@ -151,9 +151,9 @@ int main(void)
      * starship: error energy 65 % at frame 67; soft mug: seams 2.5 % at frame 14 (36 % later);
      * astronauts: seams 1.1 % at frame 31 (3 % later). That is issue 28's item 3; a scene made
      * right there changes its entry to NULL. Seventeenth session: seam ties (sem.seam_ties,
-     * default 10; docs/simulation.md "Seam ties") hold the faces together - largest openings
-     * over these frames rockets 0.033 %, chicken 0.49 %, soft mug 0.51 %, astronauts 0.17 %,
-     * starship 0.0006 %, tire 0.023 % - so the chicken and the astronauts are ok and no scene
+     * default 30; docs/simulation.md "Seam ties") hold the faces together - largest openings
+     * over these frames rockets 0.026 %, chicken 0.20 %, soft mug 0.27 %, astronauts 0.083 %,
+     * starship 0.0002 %, tire 0.016 % - so the chicken and the astronauts are ok and no scene
      * is suspect for its seams any more; the error energy (rockets, tire, starship, the stiff
      * mug) remains. */
     static const scene_case cases[] = {

@@ -201,7 +201,7 @@ typedef struct sem_object_def {
 
 #define SEM_DEFAULT_BLEND 0.02
 /* The scenes' seam tie stiffness (sem_object_def.seam_ties; docs/simulation.md). */
-#define SEM_DEFAULT_SEAM_TIES 10.0
+#define SEM_DEFAULT_SEAM_TIES 30.0
 #define SEM_WELD_TOLERANCE 1e-9
 /* Seam ties (sem_object_def.seam_ties) join the seam pairs whose points are at most this
  * far apart at rest, relative to the model's size. */
