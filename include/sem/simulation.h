@@ -194,8 +194,7 @@ typedef struct sem_object_def {
      * sem/measure.h) are held together by the energy k E sum ds |x_a - x_b - d0|^2 (ds the
      * boundary length a pair stands for, d0 its rest gap), a penalty coupling of the faces
      * along their shared edges (docs/simulation.md, "Seam ties"). It vanishes for every
-     * motion of the body as a whole, so the patch test and momentum stay. Applied with the
-     * q-space solvers; the structured solver keeps the paper's coupling. */
+     * motion of the body as a whole, so the patch test and momentum stay. */
     double seam_ties;
 } sem_object_def;
 

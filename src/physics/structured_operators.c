@@ -57,7 +57,8 @@ static sem_status build_P(sem_object *o, sem_structured_ops *s, sem_error *err)
     return SEM_OK;
 }
 
-/* The sample rows (the error rows of sem_error_rows, then ties, then welds) and Bb. */
+/* The sample rows (the error rows of sem_error_rows, then ties, then welds, then seam ties)
+ * and Bb. */
 static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties, const int *tie_ctrl,
                                 const int *tie_part, double tie_weight, double weld_weight, sem_error *err)
 {
@@ -67,7 +68,8 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     int n_err = 0;
     sem_status st = sem_error_rows(o, &rows, &n_err, err);
     if (st != SEM_OK) return st;
-    int m = o->m, ns = n_err, nw = o->n_welds, nr = ns + n_ties + nw;
+    int m = o->m, ns = n_err, nw = o->n_welds, nst = o->n_seam_ties, nr = ns + n_ties + nw + nst;
+    int r_seam = ns + n_ties + nw; /* the seam ties' first row */
     s->n_rows = nr;
     s->area = malloc(((size_t)nr + 1) * sizeof(double));
     s->j_start = malloc(((size_t)nr + 1) * sizeof(int));
@@ -79,6 +81,7 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     for (int t = 0; t < ns; ++t) s->area[t] = rows[t].weight;
     for (int t = 0; t < n_ties; ++t) s->area[ns + t] = tie_weight;
     for (int t = 0; t < nw; ++t) s->area[ns + n_ties + t] = weld_weight;
+    for (int t = 0; t < nst; ++t) s->area[r_seam + t] = o->seam_tie_weight[t];
     s->j_start[0] = s->g_start[0] = 0;
     for (int t = 0; t < ns; ++t) {
         int r = rows[t].sample;
@@ -90,9 +93,14 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
         s->j_start[ns + t + 1] = s->j_start[ns + t] + 1;
         s->g_start[ns + t + 1] = s->g_start[ns + t] + m;
     }
-    for (int t = ns + n_ties; t < nr; ++t) {
+    for (int t = ns + n_ties; t < r_seam; ++t) {
         s->j_start[t + 1] = s->j_start[t] + 2;
         s->g_start[t + 1] = s->g_start[t];
+    }
+    for (int t = 0; t < nst; ++t) {
+        int k = o->seam_tie_pair[t];
+        s->j_start[r_seam + t + 1] = s->j_start[r_seam + t] + (o->seams.row_start[2 * k + 2] - o->seams.row_start[2 * k]);
+        s->g_start[r_seam + t + 1] = s->g_start[r_seam + t];
     }
     size_t nj = (size_t)s->j_start[nr], ng = (size_t)s->g_start[nr];
     s->j_col = malloc((nj + 1) * sizeof(int));
@@ -145,6 +153,26 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
         s->j_val[s->j_start[r]] = lo == a ? 1.0 : -1.0;
         s->j_col[s->j_start[r] + 1] = hi;
         s->j_val[s->j_start[r] + 1] = hi == a ? 1.0 : -1.0;
+    }
+    /* seam ties (object_seam_ties.c): J_a - J_b, the two parts' points, ascending */
+    for (int t = 0; t < nst; ++t) {
+        const sem_seams *sm = &o->seams;
+        int k = o->seam_tie_pair[t], a1 = sm->row_start[2 * k + 1];
+        int *col = s->j_col + s->j_start[r_seam + t];
+        double *val = s->j_val + s->j_start[r_seam + t];
+        int n = 0;
+        for (int e = sm->row_start[2 * k]; e < sm->row_start[2 * k + 2]; ++e, ++n) {
+            int c = sm->row_ctrl[e];
+            double v = e < a1 ? sm->row_w[e] : -sm->row_w[e];
+            int j = n;
+            while (j > 0 && col[j - 1] > c) {
+                col[j] = col[j - 1];
+                val[j] = val[j - 1];
+                --j;
+            }
+            col[j] = c;
+            val[j] = v;
+        }
     }
     return SEM_OK;
 }

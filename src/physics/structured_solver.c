@@ -397,7 +397,7 @@ static sem_status build_F(sem_structured_solver *s, sem_error *err)
  * Ep = U_k Lambda_k^1/2 (P~ = Ep P' on the kept space): F2' = T^T F2 Ep, F3' = Ep^T F3 Ep,
  * B' = F2' - I and the constant Hc = F3' - B'^T B'. */
 #define F1_CUTOFF 1e-12
-/* The blocks F1 is decomposed in: origin groups, joined where a weld ties two of them
+/* The blocks F1 is decomposed in: origin groups, joined where a weld or a seam tie joins them
  * (union-find, each block numbered by its first group). block[g] for every group; returns
  * the number of blocks, -1 when out of memory. */
 static int blocks_of(const sem_object *o, int *block)
@@ -408,6 +408,13 @@ static int blocks_of(const sem_object *o, int *block)
     for (int g = 0; g < ng; ++g) parent[g] = g;
     for (int k = 0; k < o->n_welds; ++k)
         sem_uf_unite(parent, o->ctrl_group[o->weld_ctrl[2 * k]], o->ctrl_group[o->weld_ctrl[2 * k + 1]]);
+    for (int t = 0; t < o->n_seam_ties; ++t) { /* a seam tie's row crosses its two parts' groups */
+        const sem_seams *sm = &o->seams;
+        int k = o->seam_tie_pair[t];
+        int first = o->ctrl_group[sm->row_ctrl[sm->row_start[2 * k]]];
+        for (int e = sm->row_start[2 * k] + 1; e < sm->row_start[2 * k + 2]; ++e)
+            sem_uf_unite(parent, first, o->ctrl_group[sm->row_ctrl[e]]);
+    }
     /* a root is the lowest group of its set, so it is numbered before its members */
     for (int g = 0; g < ng; ++g) {
         int root = sem_uf_find(parent, g);

@@ -246,7 +246,7 @@ int sem_world_add_object(sem_world *w, const sem_object_def *def, sem_error *err
         st = sem_error_set(err, SEM_ERR_INVALID, "seam_ties must be >= 0 (got %g)", def->seam_ties);
         goto fail;
     }
-    if (!o->structured && (st = sem_object_find_seam_ties(o, def->seam_ties, err)) != SEM_OK) goto fail;
+    if ((st = sem_object_find_seam_ties(o, def->seam_ties, err)) != SEM_OK) goto fail;
     if ((st = sem_object_layout_init(o, err)) != SEM_OK) goto fail;
     /* material pins (before the constant matrices, which take their anchor) */
     if ((st = sem_pins_init(o, def, err)) != SEM_OK) goto fail;
