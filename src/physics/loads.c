@@ -111,8 +111,6 @@ void sem_external_force(const sem_object *o, double t, double *f)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
     memcpy(f, o->f_gravity, n * sizeof(double));
-    if (o->f_seam) /* the seam ties' rest gaps (object_seam_ties.c) */
-        for (size_t i = 0; i < n; ++i) f[i] += o->f_seam[i];
     const sem_discretization *d = o->d;
     for (int l = 0; l < o->def.n_region_loads; ++l) {
         const sem_region_load *rl = &o->def.region_loads[l];

@@ -500,12 +500,23 @@ sem_status sem_mass_error_init(sem_object *o, sem_error *err)
 static void q_space_multiply(const sem_object *o, double cM, double cE, double cK, double cD, const double *x,
                              double *y);
 
+/* The error energy is gamma u^T M_eps u of the displacement u = q - q0 (centred, since M_eps
+ * ignores translations): the same as gamma q^T M_eps q wherever M_eps q0 = 0 (Eq. 16, the blend
+ * and the orphan ties vanish at rest, being exact for affine motion), and the true energy of
+ * the rows that are not zero at rest - a seam tie across a CAD gap (object_seam_ties.c), a weld
+ * of points 1e-9 of the size apart - which hold their rest offset. Displacements rather than
+ * positions also keep the sum free of the cancellation of large coordinates. */
 double sem_error_energy(sem_object *o, const double *q, double *grad)
 {
-    const double *qc = sem_centered(o, q);
-    sem_blocks_multiply(o, 0, o->gamma, 0, 0, 0, qc, grad);
+    size_t n = 3 * (size_t)o->n_ctrl;
+    double mean[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i) mean[i % 3] += q[i] - o->q0[i];
+    for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
+    double *u = o->qc;
+    for (size_t i = 0; i < n; ++i) u[i] = q[i] - o->q0[i] - mean[i % 3];
+    sem_blocks_multiply(o, 0, o->gamma, 0, 0, 0, u, grad);
     double e = 0;
-    for (size_t i = 0; i < 3 * (size_t)o->n_ctrl; ++i) e += 0.5 * qc[i] * grad[i];
+    for (size_t i = 0; i < n; ++i) e += 0.5 * u[i] * grad[i];
     return e;
 }
 

@@ -96,8 +96,6 @@ typedef struct sem_object {
     int n_seam_ties;           /* seam pairs tied (object_seam_ties.c): indices into seams */
     int *seam_tie_pair;
     double *seam_tie_weight;   /* per tie: its row's weight in the error matrix */
-    double *f_seam;            /* the ties' rest-gap force, 3 n_ctrl, or NULL (no gap) */
-    double seam_c0;            /* gamma sum w |d0|^2 over the ties */
     int *part_tied;            /* per part: how many of its control points are tied */
     /* forces */
     double *f_gravity;         /* 3 n_ctrl */
@@ -148,9 +146,7 @@ sem_status sem_object_layout_init(sem_object *o, sem_error *err);
 sem_status sem_object_find_welds(sem_object *o, sem_error *err);
 /* Seam ties (object_seam_ties.c) of stiffness k (<= 0: none); needs o->gamma. */
 sem_status sem_object_find_seam_ties(sem_object *o, double stiffness, sem_error *err);
-/* What the ties' rest gaps add to gamma q^T M_eps q to make the error energy (0 without
- * gaps). */
-double sem_seam_ties_gap_energy(const sem_object *o, const double *q);
+
 /* The largest group (at least 1). */
 size_t sem_max_group_size(const sem_object *o);
 

@@ -52,7 +52,7 @@ sem_status sem_world_object_checks(sem_world *w, int object, sem_object_checks *
      * its volume) */
     double *work = malloc(3 * (size_t)o->n_ctrl * sizeof(double) + 1);
     if (!work) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
-    double error = sem_error_energy(o, o->q, work) + sem_seam_ties_gap_energy(o, o->q);
+    double error = sem_error_energy(o, o->q, work);
     free(work);
     sem_error e;
     double elastic = sem_assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK ? o->elastic_energy : INFINITY;

@@ -102,7 +102,7 @@ static void object_destroy(sem_object *o)
                  o->gpair_lookup, o->gpair_offset, o->part_pair_gpair, o->gpair_pairs_start, o->gpair_pairs,
                  o->K_blocks, o->M_blocks, o->E_blocks, o->me_start, o->me_col, o->me_M, o->me_E, o->K0_blocks,
                  o->A_blocks, o->K0z, o->point_H, o->point_H0, o->f_gravity, o->pinned, o->presc_index, o->presc,
-                 o->free_index, o->z, o->grad_z, o->Kz, o->qc, o->weld_ctrl, o->seam_tie_pair, o->seam_tie_weight, o->f_seam, o->grad_z_share,
+                 o->free_index, o->z, o->grad_z, o->Kz, o->qc, o->weld_ctrl, o->seam_tie_pair, o->seam_tie_weight, o->grad_z_share,
                  (void *)o->def.point_loads, (void *)o->def.region_loads);
     free(o);
 }
@@ -501,7 +501,7 @@ void sem_world_object_stats(const sem_world *w, int i, sem_object_stats *s)
     /* kinetic energy 1/2 v^T M v; error energy gamma q^T M_eps q */
     sem_blocks_multiply(o, 1.0, 0, 0, 0, 0, o->v, tmp);
     for (size_t k = 0; k < n; ++k) s->kinetic_energy += 0.5 * o->v[k] * tmp[k];
-    s->error_energy = sem_error_energy(o, o->q, tmp) + sem_seam_ties_gap_energy(o, o->q);
+    s->error_energy = sem_error_energy(o, o->q, tmp);
     sem_error e;
     if (sem_assemble_elastic(o, o->q, 0, NULL, NULL, &e) == SEM_OK)
         s->elastic_energy = o->elastic_energy;
