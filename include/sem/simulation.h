@@ -202,9 +202,6 @@ typedef struct sem_object_def {
 /* The scenes' seam tie stiffness (sem_object_def.seam_ties; docs/simulation.md). */
 #define SEM_DEFAULT_SEAM_TIES 30.0
 #define SEM_WELD_TOLERANCE 1e-9
-/* Seam ties (sem_object_def.seam_ties) join the seam pairs whose points are at most this
- * far apart at rest, relative to the model's size. */
-#define SEM_SEAM_TIE_GAP 1e-3
 #ifndef SEM_WELD_STIFFNESS
 #define SEM_WELD_STIFFNESS 1e3
 #endif

@@ -305,7 +305,7 @@ static inline void point_deformation_gradient(const sem_object *o, int p, double
 
 double sem_deformed_volume(sem_object *o, const double *q, double *min_det)
 {
-    sem_shared_coefficients(o, sem_centered(o, q), o->z);
+    sem_shared_coefficients(o, sem_centered(o, q, NULL), o->z);
     double volume = 0, lowest = INFINITY;
     for (int p = 0; p < o->n_quad; ++p) {
         double F[9];
@@ -328,7 +328,7 @@ sem_status sem_assemble_elastic(sem_object *o, const double *q, int want_hessian
     size_t nz = (size_t)o->n_parts * ma * 3;
     /* z_i = pi_shared_i Q (shared-basis coefficients), with Q centred (translation
      * invariance; see sem_centered) */
-    sem_shared_coefficients(o, sem_centered(o, q), o->z);
+    sem_shared_coefficients(o, sem_centered(o, q, NULL), o->z);
     int nth = o->nthreads;
     double energy_total = 0, share_energy[GRADIENT_SHARES] = {0};
     int bad = 0;

@@ -345,16 +345,15 @@ static sem_status setup_constant_blocks(sem_object *o, sem_error *err)
     }
     /* the seam ties (object_seam_ties.c): rows J_a - J_b */
     for (int t = 0; t < o->n_seam_ties; ++t) {
-        const sem_seams *sm = &o->seams;
-        int k = o->seam_tie_pair[t], a1 = sm->row_start[2 * k + 1];
-        int e0 = sm->row_start[2 * k], e1 = sm->row_start[2 * k + 2];
+        int e0, e1;
+        seam_tie_row(o, t, &e0, &e1);
         double wgt = o->seam_tie_weight[t];
         for (int x = e0; x < e1; ++x) {
-            double vx = x < a1 ? sm->row_w[x] : -sm->row_w[x];
-            int cx = sm->row_ctrl[x], gx = o->ctrl_group[cx];
+            double vx = seam_tie_value(o, t, x);
+            int cx = o->seams.row_ctrl[x], gx = o->ctrl_group[cx];
             for (int y = e0; y < e1; ++y) {
-                double vy = y < a1 ? sm->row_w[y] : -sm->row_w[y];
-                int cy = sm->row_ctrl[y], gy = o->ctrl_group[cy];
+                double vy = seam_tie_value(o, t, y);
+                int cy = o->seams.row_ctrl[y], gy = o->ctrl_group[cy];
                 int gp = o->gpair_lookup[(size_t)gx * o->n_groups + gy];
                 size_t nb = sem_group_size(o, gy);
                 o->E_blocks[o->gpair_offset[gp] + (size_t)o->ctrl_local[cx] * nb + (size_t)o->ctrl_local[cy]] +=
@@ -509,11 +508,7 @@ static void q_space_multiply(const sem_object *o, double cM, double cE, double c
 double sem_error_energy(sem_object *o, const double *q, double *grad)
 {
     size_t n = 3 * (size_t)o->n_ctrl;
-    double mean[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; ++i) mean[i % 3] += q[i] - o->q0[i];
-    for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
-    double *u = o->qc;
-    for (size_t i = 0; i < n; ++i) u[i] = q[i] - o->q0[i] - mean[i % 3];
+    const double *u = sem_centered(o, q, o->q0);
     sem_blocks_multiply(o, 0, o->gamma, 0, 0, 0, u, grad);
     double e = 0;
     for (size_t i = 0; i < n; ++i) e += 0.5 * u[i] * grad[i];

@@ -116,7 +116,7 @@ typedef struct sem_object {
     int nthreads;
     int exact_hessian;         /* 1: skip the PSD projection (Newton near a minimum) */
     double *grad_z_share;      /* GRADIENT_SHARES x n_parts*ma x 3 (see assembly.h) */
-    double *qc;                /* q minus its mean, 3 n_ctrl (see sem_centered) */
+    double *qc;                /* q (or q - q0) minus its mean, 3 n_ctrl (see sem_centered) */
     double elastic_energy;
     double volume, mass;
     double runaway_budget;     /* runaway.c: energy the inputs can supply */
@@ -144,8 +144,23 @@ sem_status sem_object_layout_init(sem_object *o, sem_error *err);
 /* object_welds.c: the pairs of control points that coincide at rest (sem_object_def.weld),
  * each point of a cluster paired with the cluster's lowest index. */
 sem_status sem_object_find_welds(sem_object *o, sem_error *err);
+/* object_checks.c: o->seams (the seam monitor's pairs), built on the first call. */
+sem_status sem_object_seams(sem_object *o, sem_error *err);
 /* Seam ties (object_seam_ties.c) of stiffness k (<= 0: none); needs o->gamma. */
 sem_status sem_object_find_seam_ties(sem_object *o, double stiffness, sem_error *err);
+/* Seam tie t's row J_a - J_b: its entries are seams.row_ctrl[e] for e in [*e0, *e1); entry
+ * e's value is seam_tie_value(o, t, e). */
+static inline void seam_tie_row(const sem_object *o, int t, int *e0, int *e1)
+{
+    int k = o->seam_tie_pair[t];
+    *e0 = o->seams.row_start[2 * k];
+    *e1 = o->seams.row_start[2 * k + 2];
+}
+static inline double seam_tie_value(const sem_object *o, int t, int e)
+{
+    int k = o->seam_tie_pair[t];
+    return e < o->seams.row_start[2 * k + 1] ? o->seams.row_w[e] : -o->seams.row_w[e];
+}
 
 /* The largest group (at least 1). */
 size_t sem_max_group_size(const sem_object *o);

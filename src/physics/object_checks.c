@@ -25,6 +25,14 @@
 #include "pins.h"
 #include "world.h"
 
+sem_status sem_object_seams(sem_object *o, sem_error *err)
+{
+    if (o->seams_built) return SEM_OK;
+    sem_status st = sem_seams_build(o->def.model, SEM_SEAM_TOLERANCE, &o->seams, err);
+    if (st == SEM_OK) o->seams_built = 1;
+    return st;
+}
+
 sem_status sem_world_object_checks(sem_world *w, int object, sem_object_checks *out, sem_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -33,11 +41,8 @@ sem_status sem_world_object_checks(sem_world *w, int object, sem_object_checks *
     if (object < 0 || object >= w->n_objects)
         return sem_error_set(err, SEM_ERR_INVALID, "no object %d (the world has %d)", object, w->n_objects);
     sem_object *o = w->objects[object];
-    if (!o->seams_built) {
-        sem_status st = sem_seams_build(o->def.model, SEM_SEAM_TOLERANCE, &o->seams, err);
-        if (st != SEM_OK) return st;
-        o->seams_built = 1;
-    }
+    sem_status st = sem_object_seams(o, err);
+    if (st != SEM_OK) return st;
     sem_seam_gap gap;
     sem_seams_measure(&o->seams, o->q, &gap);
     out->seam_pairs = o->seams.n_pairs;

@@ -154,11 +154,11 @@ static sem_status setup_pairs(sem_object *o, sem_error *err)
     }
     /* seam ties (object_seam_ties.c): rows over both points' control points */
     for (int t = 0; t < o->n_seam_ties; ++t) {
-        const sem_seams *sm = &o->seams;
-        int k = o->seam_tie_pair[t];
-        int e0 = sm->row_start[2 * k], e1 = sm->row_start[2 * k + 2];
+        int e0, e1;
+        seam_tie_row(o, t, &e0, &e1);
         for (int x = e0; x < e1; ++x)
-            for (int y = e0; y < e1; ++y) ADD_GPAIR(o->ctrl_group[sm->row_ctrl[x]], o->ctrl_group[sm->row_ctrl[y]]);
+            for (int y = e0; y < e1; ++y)
+                ADD_GPAIR(o->ctrl_group[o->seams.row_ctrl[x]], o->ctrl_group[o->seams.row_ctrl[y]]);
     }
 #undef ADD_GPAIR
     o->gpair_offset = malloc(((size_t)o->n_gpairs + 1) * sizeof(size_t));

@@ -21,7 +21,7 @@
  * and every solver and integrator takes it as it takes that one.
  *
  * Gaps. Where a file leaves a gap between two faces (d0 = x_a - x_b at rest, at most
- * SEM_SEAM_TOLERANCE of the size, or the pair is not a seam), the tie holds the gap as it
+ * SEM_SEAM_TOLERANCE of the size: farther points are no seam pair), the tie holds the gap as it
  * is: the error energy is measured on the displacement q - q0 (mass_error.c,
  * sem_error_energy), so a row is |D (q - q0)|^2 = |(x_a - x_b) - d0|^2 and the rest state is
  * in equilibrium. The tie vanishes for every translation, and for rotations and affine motions
@@ -40,11 +40,8 @@ sem_status sem_object_find_seam_ties(sem_object *o, double stiffness, sem_error 
     o->seam_tie_pair = NULL;
     o->seam_tie_weight = NULL;
     if (!(stiffness > 0)) return SEM_OK;
-    if (!o->seams_built) {
-        sem_status st = sem_seams_build(o->def.model, SEM_SEAM_TOLERANCE, &o->seams, err);
-        if (st != SEM_OK) return st;
-        o->seams_built = 1;
-    }
+    sem_status st = sem_object_seams(o, err);
+    if (st != SEM_OK) return st;
     const sem_seams *s = &o->seams;
     if (s->n_pairs == 0) return SEM_OK;
     o->seam_tie_pair = malloc((size_t)s->n_pairs * sizeof(int));
@@ -52,10 +49,9 @@ sem_status sem_object_find_seam_ties(sem_object *o, double stiffness, sem_error 
     if (!o->seam_tie_pair || !o->seam_tie_weight) return sem_error_set(err, SEM_ERR_NOMEM, "out of memory");
     double E = o->def.material.youngs_modulus;
     for (int k = 0; k < s->n_pairs; ++k) {
-        if (!(s->rest_distance[k] <= SEM_SEAM_TIE_GAP * s->size) || !(s->length[k] > 0)) continue;
+        if (!(s->length[k] > 0)) continue; /* a pole's single point */
         o->seam_tie_pair[o->n_seam_ties] = k;
         o->seam_tie_weight[o->n_seam_ties++] = stiffness * E * s->length[k] / o->gamma;
     }
     return SEM_OK;
 }
-

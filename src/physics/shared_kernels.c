@@ -37,14 +37,14 @@ void sem_basis_shift(int m, const double s[3], double *T)
     }
 }
 
-const double *sem_centered(sem_object *o, const double *q)
+const double *sem_centered(sem_object *o, const double *q, const double *ref)
 {
     double mean[3] = {0, 0, 0};
     for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) mean[k] += q[3 * c + k];
+        for (int k = 0; k < 3; ++k) mean[k] += q[3 * c + k] - (ref ? ref[3 * c + k] : 0);
     for (int k = 0; k < 3; ++k) mean[k] /= o->n_ctrl > 0 ? o->n_ctrl : 1;
     for (int c = 0; c < o->n_ctrl; ++c)
-        for (int k = 0; k < 3; ++k) o->qc[3 * c + k] = q[3 * c + k] - mean[k];
+        for (int k = 0; k < 3; ++k) o->qc[3 * c + k] = q[3 * c + k] - (ref ? ref[3 * c + k] : 0) - mean[k];
     return o->qc;
 }
 

@@ -28,11 +28,12 @@ void sem_stiffness_z_multiply(const sem_object *o, double ca, const double *Ka, 
 /* T (m x m, row-major) with b(y + s) = T b(y): from a part's own basis b(X - Xbar_i),
  * s = ref_X - Xbar_i, to the shared one b(X - ref_X) (see setup_stiffness in assembly.c). */
 void sem_basis_shift(int m, const double s[3], double *T);
-/* q minus the mean of its control points (per coordinate), in o->qc. Elastic and error
- * energies are translation invariant, but evaluated at q far from the origin their
- * round-off grows with |q|; a body that travels (free fall, a thrown object) would then
- * slowly lose momentum conservation. Evaluating at the centred q removes that. */
-const double *sem_centered(sem_object *o, const double *q);
+/* q - ref (ref NULL: q itself) minus its mean over the control points (per coordinate), in
+ * o->qc. Elastic and error energies are translation invariant, but evaluated at q far from
+ * the origin their round-off grows with |q|; a body that travels (free fall, a thrown object)
+ * would then slowly lose momentum conservation. Evaluating at the centred q removes that.
+ * The error energy takes ref = q0, the displacement (mass_error.c, sem_error_energy). */
+const double *sem_centered(sem_object *o, const double *q, const double *ref);
 
 /* The boundary samples' weights in the error matrix are their areas, each at least 5 % of
  * its part's mean sample area, since a collapsed edge (a sphere's pole) has a zero area

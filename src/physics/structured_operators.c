@@ -98,8 +98,9 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
         s->g_start[t + 1] = s->g_start[t];
     }
     for (int t = 0; t < nst; ++t) {
-        int k = o->seam_tie_pair[t];
-        s->j_start[r_seam + t + 1] = s->j_start[r_seam + t] + (o->seams.row_start[2 * k + 2] - o->seams.row_start[2 * k]);
+        int e0, e1;
+        seam_tie_row(o, t, &e0, &e1);
+        s->j_start[r_seam + t + 1] = s->j_start[r_seam + t] + (e1 - e0);
         s->g_start[r_seam + t + 1] = s->g_start[r_seam + t];
     }
     size_t nj = (size_t)s->j_start[nr], ng = (size_t)s->g_start[nr];
@@ -156,14 +157,13 @@ static sem_status build_samples(sem_object *o, sem_structured_ops *s, int n_ties
     }
     /* seam ties (object_seam_ties.c): J_a - J_b, the two parts' points, ascending */
     for (int t = 0; t < nst; ++t) {
-        const sem_seams *sm = &o->seams;
-        int k = o->seam_tie_pair[t], a1 = sm->row_start[2 * k + 1];
         int *col = s->j_col + s->j_start[r_seam + t];
         double *val = s->j_val + s->j_start[r_seam + t];
-        int n = 0;
-        for (int e = sm->row_start[2 * k]; e < sm->row_start[2 * k + 2]; ++e, ++n) {
-            int c = sm->row_ctrl[e];
-            double v = e < a1 ? sm->row_w[e] : -sm->row_w[e];
+        int n = 0, e0, e1;
+        seam_tie_row(o, t, &e0, &e1);
+        for (int e = e0; e < e1; ++e, ++n) {
+            int c = o->seams.row_ctrl[e];
+            double v = seam_tie_value(o, t, e);
             int j = n;
             while (j > 0 && col[j - 1] > c) {
                 col[j] = col[j - 1];

@@ -409,11 +409,10 @@ static int blocks_of(const sem_object *o, int *block)
     for (int k = 0; k < o->n_welds; ++k)
         sem_uf_unite(parent, o->ctrl_group[o->weld_ctrl[2 * k]], o->ctrl_group[o->weld_ctrl[2 * k + 1]]);
     for (int t = 0; t < o->n_seam_ties; ++t) { /* a seam tie's row crosses its two parts' groups */
-        const sem_seams *sm = &o->seams;
-        int k = o->seam_tie_pair[t];
-        int first = o->ctrl_group[sm->row_ctrl[sm->row_start[2 * k]]];
-        for (int e = sm->row_start[2 * k] + 1; e < sm->row_start[2 * k + 2]; ++e)
-            sem_uf_unite(parent, first, o->ctrl_group[sm->row_ctrl[e]]);
+        int e0, e1;
+        seam_tie_row(o, t, &e0, &e1);
+        for (int e = e0 + 1; e < e1; ++e)
+            sem_uf_unite(parent, o->ctrl_group[o->seams.row_ctrl[e0]], o->ctrl_group[o->seams.row_ctrl[e]]);
     }
     /* a root is the lowest group of its set, so it is numbered before its members */
     for (int g = 0; g < ng; ++g) {

@@ -78,6 +78,23 @@ static sem_status get_number(ctx *c, const cJSON *obj, const char *key, const ch
     return SEM_OK;
 }
 
+/* An optional number of 0..max, null meaning "the default" (*out left as it is); max_text is
+ * how the message writes the bound. */
+static sem_status get_number_upto(ctx *c, const cJSON *obj, const char *key, const char *where, double max,
+                                  const char *max_text, double *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v || cJSON_IsNull(v)) return SEM_OK;
+    sem_status st = get_number(c, obj, key, where, out);
+    if (st != SEM_OK) return st;
+    if (!(*out >= 0) || *out > max) {
+        char w[300];
+        snprintf(w, sizeof w, "%s.%s", where, key);
+        return fail(c, w, "must be in 0..%s or null (got %g)", max_text, *out);
+    }
+    return SEM_OK;
+}
+
 static sem_status get_int(ctx *c, const cJSON *obj, const char *key, const char *where, int *out)
 {
     char w[256];
@@ -645,33 +662,12 @@ static sem_status parse_object(ctx *c, const cJSON *o, int index, const char *ba
         static const int seam_rules[] = {SEM_SEAMS_GEOMETRIC, SEM_SEAMS_PAPER};
         if ((st = get_choice(c, s, "seams", w, seam_names, seam_rules, &obj->seams)) != SEM_OK) return st;
         if ((st = get_bool(c, s, "weld", w, &obj->weld)) != SEM_OK) return st;
-        const cJSON *res = cJSON_GetObjectItemCaseSensitive(s, "resolution");
-        if (res && !cJSON_IsNull(res)) {
-            if ((st = get_number(c, s, "resolution", w, &obj->resolution)) != SEM_OK) return st;
-            if (!(obj->resolution >= 0) || obj->resolution > SEM_MAX_RESOLUTION) {
-                char w2[300];
-                snprintf(w2, sizeof w2, "%s.resolution", w);
-                return fail(c, w2, "must be in 0..%d or null (got %g)", SEM_MAX_RESOLUTION, obj->resolution);
-            }
-        }
-        const cJSON *ties = cJSON_GetObjectItemCaseSensitive(s, "seam_ties");
-        if (ties && !cJSON_IsNull(ties)) {
-            if ((st = get_number(c, s, "seam_ties", w, &obj->seam_ties)) != SEM_OK) return st;
-            if (!(obj->seam_ties >= 0) || obj->seam_ties > 1e6) {
-                char w2[300];
-                snprintf(w2, sizeof w2, "%s.seam_ties", w);
-                return fail(c, w2, "must be in 0..1e6 or null (got %g)", obj->seam_ties);
-            }
-        }
-        const cJSON *bl = cJSON_GetObjectItemCaseSensitive(s, "blend");
-        if (bl && !cJSON_IsNull(bl)) {
-            if ((st = get_number(c, s, "blend", w, &obj->blend)) != SEM_OK) return st;
-            if (!(obj->blend >= 0) || obj->blend > 1e6) {
-                char w2[300];
-                snprintf(w2, sizeof w2, "%s.blend", w);
-                return fail(c, w2, "must be in 0..1e6 or null (got %g)", obj->blend);
-            }
-        }
+        char max_res[16];
+        snprintf(max_res, sizeof max_res, "%d", SEM_MAX_RESOLUTION);
+        if ((st = get_number_upto(c, s, "resolution", w, SEM_MAX_RESOLUTION, max_res, &obj->resolution)) != SEM_OK ||
+            (st = get_number_upto(c, s, "seam_ties", w, 1e6, "1e6", &obj->seam_ties)) != SEM_OK ||
+            (st = get_number_upto(c, s, "blend", w, 1e6, "1e6", &obj->blend)) != SEM_OK)
+            return st;
     }
     const cJSON *pin = find_key(o, "pin", where, w);
     if (pin) {
